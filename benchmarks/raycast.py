@@ -1,0 +1,237 @@
+"""Benchmark of :mod:`stage_sim.core.raycast` against a per-ray Amanatides–Woo traversal in numba.
+
+Run with the project's venv python: ``PYTHONPATH=. .venv/bin/python benchmarks/raycast.py``.
+Prints one JSON object per line. numba is used here only, as the reference.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import numba
+import numpy as np
+
+from stage_sim.core.raycast import GridRayCaster, RobotLayer, polygon_cells
+
+RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
+MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/
+POSES = 100
+REPEATS = 5
+SEED = 7
+MAPS = Path(__file__).resolve().parent.parent / "maps"
+CASES = ((240, 240.0, 5.6), (1081, 270.0, 30.0))
+
+
+@numba.njit(cache=True)
+def amanatides_woo(occ, robot, res, gx, gy, xs, ys, angles, rmax, owners, out_range, out_cell):
+    """Reference: one classic traversal per ray (tMax += tDelta), minor axis first on ties."""
+    h, w = occ.shape
+    for i in range(xs.shape[0]):
+        u = (xs[i] - gx) / res
+        v = (ys[i] - gy) / res
+        dx = math.cos(angles[i]) + 0.0
+        dy = math.sin(angles[i]) + 0.0
+        ix = math.floor(u)
+        iy = math.floor(v)
+        sx = 1 if dx >= 0 else -1
+        sy = 1 if dy >= 0 else -1
+        idx = 1.0 / dx if dx != 0 else math.inf
+        idy = 1.0 / dy if dy != 0 else math.inf
+        tmx = ((ix + (1 if sx > 0 else 0)) - u) * idx
+        tmy = ((iy + (1 if sy > 0 else 0)) - v) * idy
+        tdx = abs(idx)
+        tdy = abs(idy)
+        xmaj = abs(dx) >= abs(dy)
+        rc = rmax / res
+        t = 0.0
+        out_range[i] = rmax
+        out_cell[i] = -1
+        while 0 <= ix < w and 0 <= iy < h:
+            rid = robot[iy, ix]
+            if occ[iy, ix] or (rid != -1 and rid != owners[i]):
+                out_range[i] = t * res
+                out_cell[i] = iy * w + ix
+                break
+            if tmx < tmy or (tmx == tmy and not xmaj):
+                t = tmx
+                tmx += tdx
+                ix += sx
+            else:
+                t = tmy
+                tmy += tdy
+                iy += sy
+            if t >= rc:
+                break
+
+
+def load_map(name: str) -> tuple[np.ndarray, str]:
+    """Bitmap (pixel <= 127 occupied, image row 0 at the top) sampled at 0.02 m cell centres."""
+    path = MAPS / f"{name}.png"
+    if path.exists():
+        from PIL import Image
+
+        img = np.asarray(Image.open(path).convert("L")) <= 127
+        label = f"maps/{name}.png"
+    else:
+        img = procedural_office(1100, 1200)
+        label = "procedural office 1200x1100"
+    h, w = img.shape
+    scale = RESOLUTION / MAP_RESOLUTION
+    rows = ((np.arange(round(h / scale)) + 0.5) * scale).astype(np.int64)
+    cols = ((np.arange(round(w / scale)) + 0.5) * scale).astype(np.int64)
+    return img[::-1][np.ix_(np.minimum(rows, h - 1), np.minimum(cols, w - 1))], label
+
+
+def procedural_office(h: int, w: int) -> np.ndarray:
+    """Stand-in when maps/ lacks a bitmap: 5 m rooms, 2-px walls, doors, desks (pixel grid)."""
+    rng = np.random.default_rng(SEED)
+    img = np.zeros((h, w), dtype=bool)
+    img[:3], img[-3:], img[:, :3], img[:, -3:] = True, True, True, True
+    for y in range(0, h, 110):
+        img[y : y + 2] = True
+    for x in range(0, w, 100):
+        img[:, x : x + 2] = True
+    for y in range(0, h, 110):
+        for x in range(0, w, 100):
+            door = x + rng.integers(20, 70)
+            img[y : y + 2, door : door + 20] = False
+            door = y + rng.integers(20, 80)
+            img[door : door + 20, x : x + 2] = False
+    for _ in range(300):
+        y, x = rng.integers(10, h - 30), rng.integers(10, w - 30)
+        img[y : y + rng.integers(5, 20), x : x + rng.integers(5, 25)] = True
+    return img
+
+
+def scan_batch(occ: np.ndarray, poses: int, beams: int, fov_deg: float, rng) -> tuple[np.ndarray, np.ndarray]:
+    """``poses`` random free poses, ``beams`` rays each over ``fov_deg``."""
+    free = np.argwhere(~occ)
+    cells = free[rng.integers(0, len(free), poses)]
+    xy = (cells[:, ::-1] + rng.random((poses, 2))) * RESOLUTION
+    heading = rng.uniform(-math.pi, math.pi, poses)
+    fov = math.radians(fov_deg)
+    angles = heading[:, None] + np.linspace(-fov / 2, fov / 2, beams)[None, :]
+    return np.repeat(xy, beams, axis=0), angles.ravel()
+
+
+def best_of(fn, repeats: int = REPEATS) -> float:
+    """Shortest wall time of ``repeats`` calls."""
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def reference(occ, robot, xy, angles, rmax, owners):
+    rng_out = np.empty(len(angles))
+    cell_out = np.empty(len(angles), dtype=np.int64)
+
+    def run():
+        amanatides_woo(occ, robot, RESOLUTION, 0.0, 0.0, xy[:, 0], xy[:, 1], angles, rmax, owners, rng_out, cell_out)
+
+    return run, rng_out, cell_out
+
+
+def main() -> None:
+    with contextlib.suppress(AttributeError, OSError):
+        os.sched_setaffinity(0, {0})  # one core, as the targets are stated
+    rng = np.random.default_rng(SEED)
+    no_robot = None
+    for name in ("rooms", "office_1200x1100"):
+        occ, label = load_map(name)
+        caster = GridRayCaster(occ, RESOLUTION, (0.0, 0.0))
+        no_robot = np.full(occ.shape, -1, dtype=np.int32)
+        for beams, fov, rmax in CASES:
+            xy, angles = scan_batch(occ, POSES, beams, fov, rng)
+            owners = np.full(len(angles), -1, dtype=np.int64)
+            run_ref, ref_range, ref_cell = reference(occ, no_robot, xy, angles, rmax, owners)
+            run_ref()  # numba warm-up (compilation)
+            t_ref = best_of(run_ref)
+            result = caster.cast(xy, angles, rmax)
+            t_ours = best_of(lambda c=caster, xy=xy, a=angles, r=rmax: c.cast(xy, a, r))
+            single = best_of(lambda c=caster, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r), 50)
+            emit(
+                case=f"{name}_{beams}",
+                map=label,
+                rays=len(angles),
+                beams=beams,
+                fov_deg=fov,
+                range_m=rmax,
+                rays_per_s=len(angles) / t_ours,
+                reference_rays_per_s=len(angles) / t_ref,
+                ratio_to_reference=t_ref / t_ours,
+                agree=float(np.mean(result.hit_cell == ref_cell)),
+                max_abs_range_diff_m=float(np.max(np.abs(result.ranges - ref_range))),
+                single_scan_ms=single * 1e3,
+            )
+    robots_case(occ, label, caster, rng)
+
+
+def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, fov: float = 240.0, rmax: float = 5.6):
+    """The simulator's big step: every robot's scan, other robots' footprints in the way."""
+    xy, angles = scan_batch(occ, robots, beams, fov, rng)
+    centres = xy[::beams]
+    heading = rng.uniform(-math.pi, math.pi, robots)
+    box = np.array([[-0.22, -0.19], [0.22, -0.19], [0.22, 0.19], [-0.22, 0.19]])
+    cos, sin = np.cos(heading), np.sin(heading)
+    rot = np.stack([np.stack([cos, -sin], -1), np.stack([sin, cos], -1)], -2)
+    vertices = centres[:, None, :] + np.einsum("rij,vj->rvi", rot, box)
+    owners = np.repeat(np.arange(robots), beams)
+    layer = RobotLayer(caster)
+
+    def step():
+        rows, cols, ids = polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape)
+        layer.update(rows, cols, ids)
+        return caster.cast(xy, angles, rmax, owners=owners, robots=layer)
+
+    result = step()
+    t_step = best_of(step, 3)
+    t_raster = best_of(lambda: polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape), 3)
+    rows, cols, ids = polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape)
+    t_update = best_of(lambda: layer.update(rows, cols, ids), 3)
+    t_cast = best_of(lambda: caster.cast(xy, angles, rmax, owners=owners, robots=layer), 3)
+    t_static = best_of(lambda: caster.cast(xy, angles, rmax), 3)
+    grid = np.full(occ.shape, -1, dtype=np.int32)
+    grid[rows, cols] = ids
+    shared = grid[rows, cols] != ids  # cells of two or more robots block every ray
+    grid[rows[shared], cols[shared]] = -2
+    run_ref, _, ref_cell = reference(occ, grid, xy, angles, rmax, owners)
+    run_ref()
+    t_ref = best_of(run_ref, 3)
+    emit(
+        case=f"robots{robots}_{beams}",
+        map=label,
+        rays=len(angles),
+        beams=beams,
+        fov_deg=fov,
+        range_m=rmax,
+        rays_per_s=len(angles) / t_cast,
+        reference_rays_per_s=len(angles) / t_ref,
+        ratio_to_reference=t_ref / t_cast,
+        agree=float(np.mean(result.hit_cell == ref_cell)),
+        robot_hits=int(np.count_nonzero(result.hit_robot >= 0)),
+        step_ms=t_step * 1e3,
+        polygon_cells_ms=t_raster * 1e3,
+        layer_update_ms=t_update * 1e3,
+        cast_ms=t_cast * 1e3,
+        cast_without_robots_ms=t_static * 1e3,
+    )
+
+
+def emit(**fields) -> None:
+    """One JSON line, floats rounded for reading."""
+    print(json.dumps({k: round(v, 4) if isinstance(v, float) else v for k, v in fields.items()}), flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
