@@ -27,6 +27,7 @@ setup(
     entry_points={
         "console_scripts": [
             "stage_sim = stage_sim.cli:main",
+            "stageros = stage_sim.ros.stageros_main:main",
             "teleop = stage_sim.ros.teleop:main",
         ],
     },

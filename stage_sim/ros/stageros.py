@@ -1,0 +1,174 @@
+"""The ``stageros`` node: a thin rclpy layer that steps a :class:`~stage_sim.core.simulation.Simulation`.
+
+Per robot it subscribes ``cmd_vel`` and publishes ``odom``, ``base_pose_ground_truth``, ``base_scan[_k]``
+and ``stall``; for the world it publishes ``/clock`` (one per step, never 0), ``/tf`` (odom →
+base_footprint every step), ``/tf_static`` (one latched message with every fixed frame) and, on request,
+``/map``; it serves ``reset_positions``. Every stamp is sim time. Steps run on a steady wall timer at
+``interval_sim / speedup`` (``speedup <= 0``: as fast as the executor allows, still servicing callbacks
+between steps), never on the clock the node publishes.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from geometry_msgs.msg import Twist, TwistStamped
+from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
+from nav_msgs.msg import Odometry
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool
+from std_srvs.srv import Empty
+from tf2_msgs.msg import TFMessage
+
+from stage_sim.core.bundled import find_world
+from stage_sim.core.simulation import Simulation
+from stage_sim.core.world_loader import load_world
+from stage_sim.ros import conversions
+from stage_sim.ros.names import RobotNames, robot_names
+
+# Commands beyond this magnitude (m/s or rad/s) are treated as garbage, not as "go very fast".
+ABSURD_COMMAND = 1e3
+# At most one warning per robot in this many wall seconds about rejected commands.
+WARNING_THROTTLE_S = 5.0
+# The world frame of ground truth and /map.
+WORLD_FRAME = "world"
+
+RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+class StageRos(Node):
+    """Publishes a Stage world's robots on the ROS graph the way stageros does."""
+
+    def __init__(
+        self, world: str | Path | None = None, *, speedup: float | None = None, seed: int | None = None,
+        use_model_names: bool | None = None, node_name: str = "stageros", autostep: bool = True, **kwargs,
+    ) -> None:
+        """Load the world and advertise everything; ``autostep=False`` leaves stepping to the caller
+        (:meth:`step_once`), for tests and programs that drive the simulation themselves."""
+        super().__init__(node_name, **kwargs)
+        world_param = self.declare_parameter("world_file", str(world) if world is not None else "").value
+        if not world_param:
+            raise ValueError("no world given: pass WORLD on the command line or set the 'world_file' parameter")
+        description = load_world(find_world(world_param))
+        self.world_path = description.path
+        speedup_default = description.settings.speedup if speedup is None else speedup
+        self.speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
+        seed_value = int(self.declare_parameter("seed", -1 if seed is None else seed).value)
+        watchdog = float(self.declare_parameter("base_watchdog_timeout", 0.2).value)
+        model_names = bool(self.declare_parameter("use_model_names", bool(use_model_names)).value)
+        self.publish_map = bool(self.declare_parameter("publish_map", False).value)
+        stamped = bool(self.declare_parameter("use_stamped_velocity", False).value)
+
+        self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog)
+        for warning in self.sim.warnings:
+            self.get_logger().warning(str(warning))
+        robots = self.sim.robots
+        self.names: list[RobotNames] = [
+            robot_names(r.index, r.name, len(robots), len(r.rangers), model_names) for r in robots
+        ]
+        self._create_interfaces(stamped)
+        self._last_warning = [-math.inf] * len(robots)
+        self.quit_time = description.settings.quit_time
+        self.finished = False
+        period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0
+        self._timer = self.create_timer(
+            period, self.step_once, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=autostep)
+        self._publish_static()
+        self.get_logger().info(
+            f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
+            f"speedup {self.speedup:g}" + (" (as fast as possible)" if self.speedup <= 0 else ""))
+
+    # -- set-up --------------------------------------------------------------------------------------------
+
+    def _create_interfaces(self, stamped: bool) -> None:
+        self.clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_10)
+        self.tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
+        self.tf_static_pub = self.create_publisher(TFMessage, "/tf_static", LATCHED)
+        self.map_pub = self.create_publisher(OccupancyGridMsg, "/map", LATCHED) if self.publish_map else None
+        self.odom_pubs, self.truth_pubs, self.stall_pubs, self.scan_pubs = [], [], [], []
+        for index, names in enumerate(self.names):
+            self.odom_pubs.append(self.create_publisher(Odometry, names.odom, RELIABLE_10))
+            self.truth_pubs.append(self.create_publisher(Odometry, names.ground_truth, RELIABLE_10))
+            self.stall_pubs.append(self.create_publisher(Bool, names.stall, RELIABLE_10))
+            self.scan_pubs.append([self.create_publisher(LaserScan, topic, RELIABLE_10) for topic in names.scans])
+            if stamped:
+                self.create_subscription(
+                    TwistStamped, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg.twist), RELIABLE_10)
+            else:
+                self.create_subscription(
+                    Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10)
+        self.create_service(Empty, "reset_positions", self.on_reset)
+
+    def _publish_static(self) -> None:
+        """One latched /tf_static message with every robot's fixed frames (and /map if asked)."""
+        time = conversions.stamp(self.sim.sim_time_us)
+        transforms = []
+        for robot, names in zip(self.sim.robots, self.names, strict=True):
+            transforms.append(conversions.transform(names.base_footprint, names.base_link, 0, 0, 0, 0, time))
+            for ranger, frame in zip(robot.rangers, names.laser_frames, strict=True):
+                transforms.append(conversions.ranger_transform(names.base_link, frame, ranger.pose, time))
+        self.tf_static_pub.publish(TFMessage(transforms=transforms))
+        if self.map_pub is not None:
+            grid = self.sim.static.to_occupancy_grid()
+            self.map_pub.publish(conversions.occupancy_grid_msg(grid, WORLD_FRAME, time))
+
+    # -- callbacks -----------------------------------------------------------------------------------------
+
+    def on_command(self, robot: int, twist: Twist) -> None:
+        """Accept a finite, sane command; reject anything else with a throttled warning."""
+        values = (twist.linear.x, twist.linear.y, twist.angular.z)
+        if all(math.isfinite(v) and abs(v) <= ABSURD_COMMAND for v in values):
+            self.sim.set_velocity(robot, *values)
+            return
+        now = self.get_clock().now().nanoseconds / 1e9
+        if now - self._last_warning[robot] >= WARNING_THROTTLE_S:
+            self._last_warning[robot] = now
+            self.get_logger().warning(
+                f"{self.names[robot].cmd_vel}: rejected command {values} (not finite or above "
+                f"{ABSURD_COMMAND:g}); keeping the previous one")
+
+    def on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
+        """reset_positions: executor callbacks never overlap the step, so this lands between steps."""
+        self.sim.reset_positions()
+        return response
+
+    def step_once(self) -> None:
+        """One simulation step and everything it publishes."""
+        if self.finished:
+            return
+        self.sim.step()
+        self._publish_step()
+        if self.quit_time > 0 and self.sim.sim_time >= self.quit_time:
+            self.finished = True
+            self._timer.cancel()
+            self.get_logger().info(f"quit_time {self.quit_time:g} s reached")
+
+    def _publish_step(self) -> None:
+        sim = self.sim
+        time = conversions.stamp(sim.sim_time_us)
+        self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
+        true_velocity = np.where(sim.stalled[:, None], 0.0, sim.velocities)
+        transforms = []
+        for i, names in enumerate(self.names):
+            odom = sim.odometry_poses[i]
+            self.odom_pubs[i].publish(
+                conversions.odometry_msg(odom, sim.velocities[i], names.odom_frame, names.base_footprint, time))
+            self.truth_pubs[i].publish(
+                conversions.odometry_msg(sim.true_poses[i], true_velocity[i], WORLD_FRAME, names.base_footprint, time))
+            self.stall_pubs[i].publish(Bool(data=bool(sim.stalled[i])))
+            transforms.append(
+                conversions.transform(names.odom_frame, names.base_footprint, odom[0], odom[1], 0.0, odom[2], time))
+            for ranger, scan, pub, frame in zip(
+                sim.robots[i].rangers, sim.scans[i], self.scan_pubs[i], names.laser_frames, strict=True
+            ):
+                if scan.stamp == sim.sim_time:
+                    pub.publish(conversions.scan_msg(scan, ranger, frame, time))
+        self.tf_pub.publish(TFMessage(transforms=transforms))

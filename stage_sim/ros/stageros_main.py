@@ -1,0 +1,67 @@
+"""``stageros [-g] [-u] [--speedup X] [--seed N] WORLD [--ros-args ...]``: run the simulator node.
+
+A broken world prints ``file:line:column: ...`` and exits with status 2 (no traceback); Ctrl-C and the
+world's ``quit_time`` end the node cleanly with status 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+# Project rule: discovery stays on loopback unless the user chose otherwise (set before rclpy loads).
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.utilities import remove_ros_args
+
+from stage_sim.core.bundled import bundled_worlds
+from stage_sim.core.errors import WorldError
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    """Command-line options after ROS arguments have been removed."""
+    parser = argparse.ArgumentParser(
+        prog="stageros", description="Simulate a Stage world and publish it like stage_ros' stageros.",
+        epilog=f"bundled worlds: {', '.join(bundled_worlds()) or 'none installed'}")
+    parser.add_argument("-g", action="store_true", help="no GUI (accepted for compatibility; there is no GUI)")
+    parser.add_argument("-u", action="store_true", dest="use_model_names",
+                        help="name robots' topics and frames after their models instead of robot_<i>")
+    parser.add_argument("--speedup", type=float, default=None,
+                        help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
+    parser.add_argument("--seed", type=int, default=None, help="seed for drawn odometry errors and sensor noise")
+    parser.add_argument("world", nargs="?", default=None,
+                        help="a .world file, or a bundled world's name (else the 'world_file' parameter)")
+    return parser.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run stageros until Ctrl-C, shutdown or the world's quit_time; returns the exit status."""
+    argv = list(sys.argv if argv is None else argv)
+    args = parse_args(remove_ros_args(argv)[1:])
+    from stage_sim.ros.stageros import StageRos
+
+    rclpy.init(args=argv)
+    node = None
+    try:
+        node = StageRos(args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None)
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while rclpy.ok() and not node.finished:
+            executor.spin_once(timeout_sec=0.1)
+        return 0
+    except (WorldError, FileNotFoundError, ValueError) as error:
+        print(f"stageros: {error}", file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        return 0
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
