@@ -99,6 +99,14 @@ class CollisionChecker:
         refused |= self._robot_conflicts(final) & moving
         return np.where(refused[:, None], poses, candidates), refused
 
+    def overlapping(self, poses: np.ndarray) -> np.ndarray:
+        """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
+        everyone = np.flatnonzero(self._collides)
+        touching = np.zeros(len(poses), dtype=bool)
+        if everyone.size:
+            touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
+        return touching | self._robot_conflicts(poses)
+
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
         counts = self._point_count[robots]

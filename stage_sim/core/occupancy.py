@@ -9,6 +9,7 @@ import numpy as np
 OCCUPIED = 100
 FREE = 0
 UNKNOWN = -1
+RAW_UNKNOWN = 255
 
 
 @dataclass(frozen=True)
@@ -17,12 +18,14 @@ class OccupancyGrid:
 
     ``values[row, col]`` is int8: 100 occupied, 0 free, -1 unknown (or 1..99 / 0..255 in map_server's
     scale and raw modes). Row 0 is the *bottom* row (smallest y), unlike image rows. ``origin`` is the
-    pose (x, y, yaw) of the lower-left corner of cell (0, 0), as in a map_server YAML file.
+    pose (x, y, yaw) of the lower-left corner of cell (0, 0), as in a map_server YAML file. ``mode`` is
+    the map_server mode the values came from ("trinary", "scale" or "raw"); it decides what blocks.
     """
 
     values: np.ndarray
     resolution: float
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mode: str = "trinary"
 
     @property
     def width(self) -> int:
@@ -36,5 +39,21 @@ class OccupancyGrid:
 
     @property
     def occupied(self) -> np.ndarray:
-        """Boolean mask of cells that block motion and rays (value 100 in trinary maps)."""
+        """Boolean mask of cells that block motion and rays (row 0 = bottom).
+
+        Trinary and scale maps block at 100. Raw maps hold bytes 0..255 wrapped into int8; like the nav2
+        static costmap they block at 100..254 (255 is "unknown").
+        """
+        if self.mode == "raw":
+            raw = self.values.view(np.uint8)
+            return (raw >= OCCUPIED) & (raw < RAW_UNKNOWN)
         return self.values >= OCCUPIED
+
+    def occupied_image_rows(self) -> np.ndarray:
+        """:attr:`occupied` with row 0 = top, the row order of images and of ``Bitmap.occupied``."""
+        return np.flipud(self.occupied)
+
+    @property
+    def extent(self) -> tuple[float, float]:
+        """Width and height of the whole grid in metres."""
+        return self.width * self.resolution, self.height * self.resolution

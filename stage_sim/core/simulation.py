@@ -66,6 +66,11 @@ class Simulation:
         self._uses_odom = np.array([r.settings.localization == "odom" for r in self.robots], dtype=bool)
         self._odom_origin = np.array(
             [self._odometry_origin(r) for r in self.robots], dtype=np.float64).reshape(n, 3)
+        for index in np.flatnonzero(self._collision.overlapping(self._start)):
+            robot = self.robots[index]
+            self.warnings.append(WorldWarning(
+                f"robot '{robot.name}' starts overlapping an obstacle or another robot: it will stall until "
+                "it moves clear", robot.model.location))
         self.reset(seed)
 
     @classmethod

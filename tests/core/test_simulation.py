@@ -243,3 +243,10 @@ def test_reset_with_seed_restarts_time_and_random_draws() -> None:
     assert sim.sim_time == 0.0
     assert np.array_equal(sim.odom_errors, errors)
     assert sim.true_poses[0] == pytest.approx([2.0, 2.0, 0.0])
+
+
+def test_a_robot_starting_inside_a_wall_is_reported() -> None:
+    sim = sim_of('bot( pose [9.9 5 0 0] name "stuck" ) bot( pose [2 2 0 0] name "free" )')
+    messages = [w.message for w in sim.warnings]
+    assert any("'stuck' starts overlapping" in m for m in messages)
+    assert not any("'free'" in m for m in messages)
