@@ -10,7 +10,10 @@ PYTEST_ARGS ?=
 # Keep DDS discovery on loopback unless the user chose otherwise (project rule for every process).
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 
-.PHONY: setup test lint clean-venv
+.PHONY: setup run test lint bench clean-venv
+
+WORLD ?= worlds/rooms.world
+RUN_ARGS ?=
 
 setup: $(VENV)/.package.stamp
 
@@ -38,8 +41,15 @@ $(VENV)/.package.stamp: $(VENV)/.tf2_msgs.stamp setup.py setup.cfg package.xml p
 	  echo "make setup: step 'stage_sim' failed: 'pip install -e .' did not work; see the error above" >&2; exit 1; }
 	@touch $@
 
+run: setup
+	$(VENV)/bin/stageros $(RUN_ARGS) $(WORLD)
+
 test: setup
 	$(PY) -m pytest $(PYTEST_ARGS)
+
+bench: setup
+	$(PY) benchmarks/raycast.py
+	$(PY) benchmarks/simulate.py
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts

@@ -1,0 +1,135 @@
+"""stageros as users run it: the console script in its own process, driven from this one."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
+
+from tests.ros.helpers import spin_until
+
+STAGEROS = Path(sys.executable).with_name("stageros")
+
+
+def start_stageros(cwd: Path, *args: str) -> subprocess.Popen:
+    """The console script on the bundled rooms world, from a directory that does not hold it."""
+    return subprocess.Popen(
+        [str(STAGEROS), *args, "rooms.world"], cwd=cwd, env=dict(os.environ),
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )
+
+
+def stop(process: subprocess.Popen) -> tuple[int, str]:
+    process.send_signal(signal.SIGINT)
+    try:
+        output, _ = process.communicate(timeout=15)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        output, _ = process.communicate()
+        raise
+    return process.returncode, output
+
+
+def rss_mb(pid: int) -> float:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    raise AssertionError("no VmRSS")
+
+
+def seconds(stamp) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+@pytest.mark.slow
+def test_console_script_scans_drives_resets_and_exits_on_ctrl_c(ros_context, executor, tmp_path) -> None:
+    process = start_stageros(tmp_path, "--speedup", "4")
+    try:
+        node = Node("driver", context=ros_context)
+        executor.add_node(node)
+        scans: list[LaserScan] = []
+        truth: list[Odometry] = []
+        node.create_subscription(LaserScan, "base_scan", scans.append, 100)
+        node.create_subscription(Odometry, "base_pose_ground_truth", truth.append, 100)
+        assert spin_until(executor, lambda: len(scans) >= 5 and truth, timeout_s=30), process.poll()
+        stamps = [seconds(s.header.stamp) for s in scans[-5:]]
+        assert [round(b - a, 6) for a, b in itertools.pairwise(stamps)] == [0.1] * 4
+        assert len(scans[-1].ranges) == 240 and scans[-1].header.frame_id == "base_laser_link"
+        start = truth[-1].pose.pose.position
+        start_xy = (start.x, start.y)
+
+        cmd = node.create_publisher(Twist, "cmd_vel", 10)
+        forward = Twist()
+        forward.angular.z = 0.8
+        forward.linear.x = 0.2
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            cmd.publish(forward)
+            executor.spin_once(timeout_sec=0.02)
+            p = truth[-1].pose.pose.position
+            if math.hypot(p.x - start_xy[0], p.y - start_xy[1]) > 0.1:
+                break
+        moved = truth[-1].pose.pose.position
+        assert math.hypot(moved.x - start_xy[0], moved.y - start_xy[1]) > 0.1
+
+        client = node.create_client(Empty, "reset_positions")
+        assert client.wait_for_service(timeout_sec=10)
+        future = client.call_async(Empty.Request())
+        executor.spin_until_future_complete(future, timeout_sec=10)
+        assert future.done()
+        count = len(truth)
+        assert spin_until(executor, lambda: len(truth) >= count + 3, timeout_s=10)
+        back = truth[-1].pose.pose.position
+        assert (back.x, back.y) == pytest.approx(start_xy, abs=1e-6)
+    finally:
+        code, output = stop(process)
+    assert code == 0, output
+
+
+@pytest.mark.slow
+def test_a_flood_of_commands_neither_slows_the_clock_nor_grows_memory(ros_context, executor, tmp_path) -> None:
+    process = start_stageros(tmp_path)  # real time: 10 steps per wall second
+    try:
+        node = Node("flooder", context=ros_context)
+        executor.add_node(node)
+        clock: list[tuple[float, float]] = []
+        node.create_subscription(Clock, "/clock", lambda m: clock.append((time.monotonic(), seconds(m.clock))), 100)
+        cmd = node.create_publisher(Twist, "cmd_vel", 10)
+        assert spin_until(executor, lambda: len(clock) >= 5 and cmd.get_subscription_count() > 0, timeout_s=30)
+        rss_before = rss_mb(process.pid)
+        values = [math.nan, 1e9, -math.inf, 0.3, 0.0, 5e3, 0.5]
+        messages = [Twist() for _ in values]
+        for msg, value in zip(messages, values, strict=True):
+            msg.linear.x = value
+            msg.angular.z = -value if math.isfinite(value) else value
+        window_start = len(clock)
+        sent, start = 0, time.monotonic()
+        while (now := time.monotonic()) - start < 10.0:
+            while sent < (now - start) * 2000:
+                cmd.publish(messages[sent % len(messages)])
+                sent += 1
+            executor.spin_once(timeout_sec=0)
+        assert sent >= 19_000
+        window = clock[window_start:]
+        (wall0, sim0), (wall1, sim1) = window[0], window[-1]
+        rate = (sim1 - sim0) / (wall1 - wall0)
+        assert rate == pytest.approx(1.0, abs=0.05)
+        growth = rss_mb(process.pid) - rss_before
+        assert growth < 20, f"resident memory grew by {growth:.1f} MB"
+    finally:
+        code, output = stop(process)
+    assert code == 0, output
+    assert "rejected command" in output
