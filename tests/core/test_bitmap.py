@@ -1,0 +1,64 @@
+"""Stage bitmap semantics: the first channel decides, ≤ 127 is occupied; the occupied box is found."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from stage_sim.core.bitmap import load_stage_bitmap, occupied_bounding_box
+from stage_sim.core.errors import SourceLocation, WorldError
+
+
+def save(tmp_path: Path, name: str, array: np.ndarray, mode: str | None = None) -> Path:
+    path = tmp_path / name
+    Image.fromarray(array.astype(np.uint8), mode=mode).save(path)
+    return path
+
+
+def test_threshold_127_is_occupied_128_is_free(tmp_path: Path) -> None:
+    grey = np.array([[0, 127, 128, 255]])
+    mask = load_stage_bitmap(save(tmp_path, "g.png", grey))
+    assert mask.tolist() == [[True, True, False, False]]
+
+
+def test_rgb_uses_the_red_channel_only_and_alpha_is_ignored(tmp_path: Path) -> None:
+    rgba = np.array([[[0, 0, 255, 0], [255, 0, 0, 255], [100, 255, 255, 255], [200, 0, 0, 0]]])
+    mask = load_stage_bitmap(save(tmp_path, "c.png", rgba, "RGBA"))
+    # pure blue is occupied, pure red free (spec §9.1)
+    assert mask.tolist() == [[True, False, True, False]]
+
+
+def test_pgm_and_row_order_top_first(tmp_path: Path) -> None:
+    grey = np.full((3, 2), 255)
+    grey[0, 1] = 0
+    path = tmp_path / "m.pgm"
+    Image.fromarray(grey.astype(np.uint8)).save(path)
+    mask = load_stage_bitmap(path)
+    assert mask.shape == (3, 2) and mask[0, 1] and mask.sum() == 1
+
+
+def test_occupied_bounding_box(tmp_path: Path) -> None:
+    mask = np.zeros((6, 8), dtype=bool)
+    mask[1, 2] = mask[4, 6] = True
+    box = occupied_bounding_box(mask)
+    assert tuple(box) == (1, 5, 2, 7)  # half-open: rows 1..4, cols 2..6
+    assert occupied_bounding_box(np.zeros((3, 3), dtype=bool)) is None
+
+
+def test_missing_bitmap_names_the_path_and_the_asking_line(tmp_path: Path) -> None:
+    where = SourceLocation("w.world", 12, 5)
+    missing = tmp_path / "nope.png"
+    with pytest.raises(WorldError) as error:
+        load_stage_bitmap(missing, where)
+    assert str(error.value).startswith("w.world:12:5:")
+    assert str(missing) in str(error.value)
+
+
+def test_corrupt_image_is_a_world_error(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"not a png at all")
+    with pytest.raises(WorldError, match=r"bad\.png"):
+        load_stage_bitmap(bad)
