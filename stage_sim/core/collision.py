@@ -23,6 +23,13 @@ from stage_sim.core.polygon_raster import point_cells
 MAX_CONFLICT_ROUNDS = 4
 
 
+def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """World coordinates of body points (P, 2), each given with the pose (P, 3) of its robot."""
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    px, py = points[:, 0], points[:, 1]
+    return np.stack([poses[:, 0] + c * px - s * py, poses[:, 1] + s * px + c * py], axis=-1)
+
+
 @dataclass
 class Bodies:
     """All robots' outline points, concatenated, with the robot each point belongs to."""
@@ -44,11 +51,7 @@ class Bodies:
 
     def point_cells(self, poses: np.ndarray, grid: GridFrame) -> np.ndarray:
         """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
-        pose = poses[self.owner]
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        px, py = self.points[:, 0], self.points[:, 1]
-        world = np.stack([pose[:, 0] + c * px - s * py, pose[:, 1] + s * px + c * py], axis=-1)
-        return point_cells(world, grid.resolution, grid.origin_xy, grid.shape)
+        return point_cells(place(self.points, poses[self.owner]), grid.resolution, grid.origin_xy, grid.shape)
 
 
 @dataclass(frozen=True)
@@ -107,6 +110,9 @@ class CollisionChecker:
             touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
         return touching | self._robot_conflicts(poses)
 
+    def _cells(self, points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        return point_cells(place(points, poses), self.grid.resolution, self.grid.origin_xy, self.grid.shape)
+
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
         counts = self._point_count[robots]
@@ -125,11 +131,7 @@ class CollisionChecker:
             substeps, substeps)
         probes = integrate(poses[robot], velocities[robot] * fraction[:, None], dt)
         point_index, probe = self._points_of(robot)
-        pose = probes[probe]
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        px, py = self.bodies.points[point_index, 0], self.bodies.points[point_index, 1]
-        world = np.stack([pose[:, 0] + c * px - s * py, pose[:, 1] + s * px + c * py], axis=-1)
-        cells = point_cells(world, self.grid.resolution, self.grid.origin_xy, self.grid.shape)
+        cells = self._cells(self.bodies.points[point_index], probes[probe])
         point_robot = robot[probe]
         layer_index = self._layer_of_robot[point_robot]
         hit = np.zeros(len(cells), dtype=bool)
@@ -146,11 +148,7 @@ class CollisionChecker:
             return conflict
         point_index, entry = self._points_of(colliding)
         owner = colliding[entry]
-        pose = poses[owner]
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        px, py = self.bodies.points[point_index, 0], self.bodies.points[point_index, 1]
-        world = np.stack([pose[:, 0] + c * px - s * py, pose[:, 1] + s * px + c * py], axis=-1)
-        cells = point_cells(world, self.grid.resolution, self.grid.origin_xy, self.grid.shape)
+        cells = self._cells(self.bodies.points[point_index], poses[owner])
         keep = cells >= 0
         cells, owner = cells[keep], owner[keep]
         grid = self._owner_grid
