@@ -133,3 +133,21 @@ def test_a_flood_of_commands_neither_slows_the_clock_nor_grows_memory(ros_contex
         code, output = stop(process)
     assert code == 0, output
     assert "rejected command" in output
+
+
+def test_a_broken_world_exits_2_with_its_location_and_no_traceback(tmp_path) -> None:
+    broken = tmp_path / "broken.world"
+    broken.write_text('resolution 0.02\nposition( pose [1 2 0 0] drive "hover" )\n')
+    result = subprocess.run([str(STAGEROS), "-g", str(broken)], capture_output=True, text=True, timeout=60,
+                            env=dict(os.environ))
+    assert result.returncode == 2
+    assert f"{broken}:2:" in result.stderr
+    assert "hover" in result.stderr
+    assert "Traceback" not in result.stderr + result.stdout
+
+
+def test_a_missing_world_names_the_bundled_ones(tmp_path) -> None:
+    result = subprocess.run([str(STAGEROS), "no_such.world"], capture_output=True, text=True, timeout=60,
+                            cwd=tmp_path, env=dict(os.environ))
+    assert result.returncode == 2
+    assert "rooms.world" in result.stderr and "Traceback" not in result.stderr
