@@ -151,3 +151,12 @@ def test_a_missing_world_names_the_bundled_ones(tmp_path) -> None:
                             cwd=tmp_path, env=dict(os.environ))
     assert result.returncode == 2
     assert "rooms.world" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_quit_time_ends_the_node_cleanly(tmp_path) -> None:
+    world = tmp_path / "short.world"
+    world.write_text('quit_time 3\nresolution 0.02\nmodel( size [1 1 1] pose [3 0 0 0] )\nposition( pose [0 0 0 0] )\n')
+    result = subprocess.run([str(STAGEROS), "--speedup", "0", str(world)], capture_output=True, text=True,
+                            timeout=60, env=dict(os.environ))
+    assert result.returncode == 0, result.stderr
+    assert "quit_time 3 s reached" in result.stderr + result.stdout
