@@ -19,7 +19,9 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 import numba
 import numpy as np
 
-from stage_sim.core.raycast import GridRayCaster, RobotLayer, polygon_cells
+from stage_sim.core.polygon_raster import outline_points, point_cells
+from stage_sim.core.raycast import GridRayCaster
+from stage_sim.core.robot_layer import RobotLayer
 
 RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
 MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/
@@ -185,19 +187,26 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
     box = np.array([[-0.22, -0.19], [0.22, -0.19], [0.22, 0.19], [-0.22, 0.19]])
     cos, sin = np.cos(heading), np.sin(heading)
     rot = np.stack([np.stack([cos, -sin], -1), np.stack([sin, cos], -1)], -2)
-    vertices = centres[:, None, :] + np.einsum("rij,vj->rvi", rot, box)
+    # Robots as the simulation places them: cells of points sampled along their outlines.
+    outline = outline_points(box, RESOLUTION / 2)
+    points = centres[:, None, :] + np.einsum("rij,pj->rpi", rot, outline)
+    point_ids = np.repeat(np.arange(robots), len(outline))
     owners = np.repeat(np.arange(robots), beams)
     layer = RobotLayer(caster)
 
+    def footprints():
+        flat = point_cells(points, RESOLUTION, (0.0, 0.0), occ.shape).ravel()
+        keep = flat >= 0
+        return flat[keep] // occ.shape[1], flat[keep] % occ.shape[1], point_ids[keep]
+
     def step():
-        rows, cols, ids = polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape)
-        layer.update(rows, cols, ids)
+        layer.update(*footprints())
         return caster.cast(xy, angles, rmax, owners=owners, robots=layer)
 
     result = step()
     t_step = best_of(step, 3)
-    t_raster = best_of(lambda: polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape), 3)
-    rows, cols, ids = polygon_cells(vertices, RESOLUTION, (0.0, 0.0), occ.shape)
+    t_raster = best_of(footprints, 3)
+    rows, cols, ids = footprints()
     t_update = best_of(lambda: layer.update(rows, cols, ids), 3)
     t_cast = best_of(lambda: caster.cast(xy, angles, rmax, owners=owners, robots=layer), 3)
     t_static = best_of(lambda: caster.cast(xy, angles, rmax), 3)
@@ -221,7 +230,7 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
         agree=float(np.mean(result.hit_cell == ref_cell)),
         robot_hits=int(np.count_nonzero(result.hit_robot >= 0)),
         step_ms=t_step * 1e3,
-        polygon_cells_ms=t_raster * 1e3,
+        footprint_cells_ms=t_raster * 1e3,
         layer_update_ms=t_update * 1e3,
         cast_ms=t_cast * 1e3,
         cast_without_robots_ms=t_static * 1e3,

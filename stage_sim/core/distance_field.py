@@ -15,8 +15,6 @@ over free space in a few vectorised steps instead of visiting every cell.
 * :func:`run_lengths` – for each cell and each of the four axis directions, how many consecutive
   free cells start at that cell (0 if it is occupied). The caster uses them to test a whole straight
   stretch of a ray (all the cells it visits in one row or column) with a single lookup.
-* :func:`block_summary` / :func:`neighbourhood_summary` – the coarse "which robots are around here"
-  pyramid used to certify robot-free space (see :class:`stage_sim.core.raycast.RobotLayer`).
 
 The grids passed in are already padded by the caller; cells outside the array count as free.
 """
@@ -29,10 +27,6 @@ import numpy as np
 SQUARE_CAP = 255
 #: Run lengths are capped at the largest uint16, longer than any map edge we rasterise.
 RUN_CAP = 65535
-#: Sentinels of the (lowest, highest) robot-id summaries: an empty summary is (NO_ROBOT_LO, NO_ROBOT_HI),
-#: so min/max merging keeps "empty" neutral and any two different ids give lo < hi ("several robots").
-NO_ROBOT_LO = np.iinfo(np.int32).max
-NO_ROBOT_HI = -1
 
 
 def quadrant_square_fields(occupied: np.ndarray) -> np.ndarray:
@@ -82,31 +76,3 @@ def run_lengths(occupied: np.ndarray) -> np.ndarray:
     prv = np.maximum.accumulate(np.where(occ, ys, -1 - big), axis=0)
     out[3] = np.minimum(ys - prv, RUN_CAP)
     return out
-
-
-def block_summary(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Merge 2×2 blocks of (lowest id, highest id) summaries into the next coarser level."""
-    h, w = lo.shape
-    ph, pw = h + (h & 1), w + (w & 1)
-    if (ph, pw) != (h, w):
-        lo = np.pad(lo, ((0, ph - h), (0, pw - w)), constant_values=NO_ROBOT_LO)
-        hi = np.pad(hi, ((0, ph - h), (0, pw - w)), constant_values=NO_ROBOT_HI)
-    lo4 = lo.reshape(ph // 2, 2, pw // 2, 2)
-    hi4 = hi.reshape(ph // 2, 2, pw // 2, 2)
-    return lo4.min(axis=(1, 3)), hi4.max(axis=(1, 3))
-
-
-def neighbourhood_summary(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(lowest, highest) robot id over each block's 3×3 block neighbourhood."""
-    return _box3(lo, np.minimum), _box3(hi, np.maximum)
-
-
-def _box3(a: np.ndarray, op: np.ufunc) -> np.ndarray:
-    """Separable 3×3 min or max filter (edges use the cells that exist)."""
-    r = a.copy()
-    op(r[1:, :], a[:-1, :], out=r[1:, :])
-    op(r[:-1, :], a[1:, :], out=r[:-1, :])
-    c = r.copy()
-    op(c[:, 1:], r[:, :-1], out=c[:, 1:])
-    op(c[:, :-1], r[:, 1:], out=c[:, :-1])
-    return c

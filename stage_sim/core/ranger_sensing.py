@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from stage_sim.core.collision import Bodies, GridFrame
-from stage_sim.core.raycast import SEVERAL_ROBOTS, GridRayCaster, RobotLayer
+from stage_sim.core.raycast import GridRayCaster
+from stage_sim.core.robot_layer import SEVERAL_ROBOTS, RobotLayer
 from stage_sim.core.robot_model import RobotSpec
 from stage_sim.core.world_raster import StaticRaster
 

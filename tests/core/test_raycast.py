@@ -17,7 +17,9 @@ import math
 import numpy as np
 import pytest
 
-from stage_sim.core.raycast import SEVERAL_ROBOTS, GridRayCaster, RobotLayer, polygon_cells
+from stage_sim.core.polygon_raster import fill_polygon
+from stage_sim.core.raycast import GridRayCaster
+from stage_sim.core.robot_layer import SEVERAL_ROBOTS, RobotLayer
 
 RES = 0.05
 ORIGIN = (-1.25, 0.75)
@@ -82,6 +84,16 @@ def sample(occ, res, origin, x, y, angle, rmax, step):
         line = max(row[first], row[first - 1])
         entry = (origin[1] + line * res - y) / dy
     return entry, row[first] * w + col[first], False
+
+
+def polygon_cells(polygons, res, origin, shape):
+    """(rows, cols, polygon index) of the filled polygons (P, M, 2) or (M, 2), one fill each."""
+    polys = np.asarray(polygons, dtype=np.float64)
+    polys = polys[None] if polys.ndim == 2 else polys
+    cells = [fill_polygon(p, res, origin, shape) for p in polys]
+    flat = np.concatenate(cells)
+    ids = np.repeat(np.arange(len(cells)), [len(c) for c in cells])
+    return flat // shape[1], flat % shape[1], ids
 
 
 def random_map(rng, h=48, w=64, blocks=35):
