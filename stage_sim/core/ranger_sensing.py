@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stage_sim.core.collision import Bodies, GridFrame
+from stage_sim.core.collision import Bodies, GridFrame, place
 from stage_sim.core.raycast import GridRayCaster
 from stage_sim.core.robot_layer import SEVERAL_ROBOTS, RobotLayer
 from stage_sim.core.robot_model import RobotSpec
@@ -112,9 +112,7 @@ class RangerSensing:
     ) -> None:
         owner = self._owner[rays]
         pose = poses[owner]
-        c, s = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-        ox, oy = self._offset[rays, 0], self._offset[rays, 1]
-        origins = np.stack([pose[:, 0] + c * ox - s * oy, pose[:, 1] + s * ox + c * oy], axis=1)
+        origins = place(self._offset[rays], pose)
         angles = pose[:, 2] + self._angle[rays] + jitter[rays]
         layer = None
         if robot_cells is not None:
