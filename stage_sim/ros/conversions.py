@@ -34,11 +34,10 @@ def yaw_quaternion(yaw: float) -> Quaternion:
     return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
 
 
-def scan_msg(scan: Scan, ranger: RangerSpec, frame_id: str, time: Time) -> LaserScan:
-    """A LaserScan as stageros fills it: CCW from −fov/2, a miss reads exactly range_max."""
+def scan_msg(ranger: RangerSpec, frame_id: str) -> LaserScan:
+    """A LaserScan with everything that never changes for this ranger: CCW from −fov/2, its range limits."""
     sensor = ranger.sensor
     msg = LaserScan()
-    msg.header.stamp = time
     msg.header.frame_id = frame_id
     msg.angle_min = -sensor.fov / 2
     msg.angle_max = sensor.fov / 2
@@ -47,26 +46,42 @@ def scan_msg(scan: Scan, ranger: RangerSpec, frame_id: str, time: Time) -> Laser
     msg.scan_time = ranger.update_interval
     msg.range_min = sensor.range_min
     msg.range_max = sensor.range_max
+    return msg
+
+
+def fill_scan(msg: LaserScan, scan: Scan, time: Time) -> LaserScan:
+    """Put one measurement into a ranger's message: a miss reads exactly range_max."""
+    msg.header.stamp = time
     msg.ranges = array("f", scan.ranges.astype(np.float32).tobytes())
     msg.intensities = array("f", scan.intensities.astype(np.float32).tobytes())
     return msg
 
 
-def odometry_msg(
-    pose: np.ndarray, velocity: np.ndarray, frame_id: str, child_frame_id: str, time: Time
-) -> Odometry:
-    """Odometry with pose (x, y, yaw) in ``frame_id`` and body-frame twist (vx, vy, va); covariances 0."""
+def odometry_msg(frame_id: str, child_frame_id: str) -> Odometry:
+    """An Odometry between two frames, covariances 0 (as stageros sends them)."""
     msg = Odometry()
-    msg.header.stamp = time
     msg.header.frame_id = frame_id
     msg.child_frame_id = child_frame_id
-    msg.pose.pose.position.x = float(pose[0])
-    msg.pose.pose.position.y = float(pose[1])
-    msg.pose.pose.orientation = yaw_quaternion(float(pose[2]))
-    msg.twist.twist.linear.x = float(velocity[0])
-    msg.twist.twist.linear.y = float(velocity[1])
-    msg.twist.twist.angular.z = float(velocity[2])
     return msg
+
+
+def fill_odometry(msg: Odometry, pose: np.ndarray, velocity: np.ndarray, time: Time) -> Odometry:
+    """Pose (x, y, yaw) in the message's frame and body-frame twist (vx, vy, va)."""
+    msg.header.stamp = time
+    position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
+    position.x, position.y = float(pose[0]), float(pose[1])
+    orientation.z, orientation.w = math.sin(pose[2] / 2), math.cos(pose[2] / 2)
+    twist = msg.twist.twist
+    twist.linear.x, twist.linear.y, twist.angular.z = float(velocity[0]), float(velocity[1]), float(velocity[2])
+    return msg
+
+
+def fill_planar_transform(t: TransformStamped, x: float, y: float, yaw: float, time: Time) -> TransformStamped:
+    """Move a planar TF edge (z = 0) to (x, y, yaw) at ``time``."""
+    t.header.stamp = time
+    t.transform.translation.x, t.transform.translation.y = float(x), float(y)
+    t.transform.rotation.z, t.transform.rotation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    return t
 
 
 def transform(parent: str, child: str, x: float, y: float, z: float, yaw: float, time: Time) -> TransformStamped:

@@ -11,10 +11,11 @@ between steps), never on the clock the node publishes.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from geometry_msgs.msg import Twist, TwistStamped
+from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
@@ -42,6 +43,17 @@ WORLD_FRAME = "world"
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+@dataclass
+class _RobotMessages:
+    """The messages one robot publishes every step, allocated once."""
+
+    odom: Odometry
+    truth: Odometry
+    stall: Bool
+    odom_tf: TransformStamped
+    scans: list[LaserScan]
 
 
 class StageRos(Node):
@@ -106,6 +118,18 @@ class StageRos(Node):
                 self.create_subscription(
                     Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10)
         self.create_service(Empty, "reset_positions", self.on_reset)
+        # Messages are built once and refilled every step: publishing serialises them, so reuse is safe.
+        self._out = [
+            _RobotMessages(
+                odom=conversions.odometry_msg(names.odom_frame, names.base_footprint),
+                truth=conversions.odometry_msg(WORLD_FRAME, names.base_footprint),
+                stall=Bool(),
+                odom_tf=conversions.transform(names.odom_frame, names.base_footprint, 0, 0, 0, 0, conversions.stamp(0)),
+                scans=[conversions.scan_msg(r, f) for r, f in zip(robot.rangers, names.laser_frames, strict=True)],
+            )
+            for robot, names in zip(self.sim.robots, self.names, strict=True)
+        ]
+        self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
 
     def _publish_static(self) -> None:
         """One latched /tf_static message with every robot's fixed frames (and /map if asked)."""
@@ -156,19 +180,14 @@ class StageRos(Node):
         time = conversions.stamp(sim.sim_time_us)
         self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
         true_velocity = np.where(sim.stalled[:, None], 0.0, sim.velocities)
-        transforms = []
-        for i, names in enumerate(self.names):
+        for i, out in enumerate(self._out):
             odom = sim.odometry_poses[i]
-            self.odom_pubs[i].publish(
-                conversions.odometry_msg(odom, sim.velocities[i], names.odom_frame, names.base_footprint, time))
-            self.truth_pubs[i].publish(
-                conversions.odometry_msg(sim.true_poses[i], true_velocity[i], WORLD_FRAME, names.base_footprint, time))
-            self.stall_pubs[i].publish(Bool(data=bool(sim.stalled[i])))
-            transforms.append(
-                conversions.transform(names.odom_frame, names.base_footprint, odom[0], odom[1], 0.0, odom[2], time))
-            for ranger, scan, pub, frame in zip(
-                sim.robots[i].rangers, sim.scans[i], self.scan_pubs[i], names.laser_frames, strict=True
-            ):
+            self.odom_pubs[i].publish(conversions.fill_odometry(out.odom, odom, sim.velocities[i], time))
+            self.truth_pubs[i].publish(conversions.fill_odometry(out.truth, sim.true_poses[i], true_velocity[i], time))
+            out.stall.data = bool(sim.stalled[i])
+            self.stall_pubs[i].publish(out.stall)
+            conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
+            for scan, pub, msg in zip(sim.scans[i], self.scan_pubs[i], out.scans, strict=True):
                 if scan.stamp == sim.sim_time:
-                    pub.publish(conversions.scan_msg(scan, ranger, frame, time))
-        self.tf_pub.publish(TFMessage(transforms=transforms))
+                    pub.publish(conversions.fill_scan(msg, scan, time))
+        self.tf_pub.publish(self._tf)
