@@ -255,6 +255,7 @@ class _Loader:
         bitmap = props.take("bitmap")
         if bitmap is not None:
             model.bitmap = self._bitmap(bitmap, props.string("bitmap", ""))
+            self._warn_if_trimmed(model)
 
     def _children(self, model: Model, instance: _Instance, depth: int) -> list[Sensor]:
         """Blocks and child models go into ``model``; sensors are returned for the ranger to sort out."""
@@ -346,6 +347,26 @@ class _Loader:
             bitmap = Bitmap(path, load_stage_bitmap(path, requested_at=prop.location), None, prop.location)
         self.bitmaps[path] = bitmap
         return bitmap
+
+    def _warn_if_trimmed(self, model: Model) -> None:
+        """Stage stretches only the occupied pixels' bounding box to ``size``: say so when margins are cut."""
+        from stage_sim.core.bitmap import occupied_bounding_box
+
+        bitmap = model.bitmap
+        if bitmap is None or bitmap.grid is not None:
+            return
+        height, width = bitmap.occupied.shape
+        box = occupied_bounding_box(bitmap.occupied)
+        if box is None or (box.row1 - box.row0, box.col1 - box.col0) == (height, width):
+            return
+        used_w, used_h = box.col1 - box.col0, box.row1 - box.row0
+        self.warnings.add(
+            f"bitmap {bitmap.path.name}: only its occupied pixels ({used_w}x{used_h} of {width}x{height}) are "
+            f"stretched to size [{model.size[0]:g} {model.size[1]:g}], as in Stage, so a pixel spans "
+            f"{model.size[0] / used_w:.5f} x {model.size[1] / used_h:.5f} m instead of "
+            f"{model.size[0] / width:.5f} x {model.size[1] / height:.5f} m; add dark corner pixels to keep the scale",
+            bitmap.location,
+        )
 
     def _window(self, instance: _Instance) -> WindowSettings:
         _no_children(instance)

@@ -62,3 +62,20 @@ def test_corrupt_image_is_a_world_error(tmp_path: Path) -> None:
     bad.write_bytes(b"not a png at all")
     with pytest.raises(WorldError, match=r"bad\.png"):
         load_stage_bitmap(bad)
+
+
+def test_trimmed_white_margins_are_warned_about_with_the_resulting_scale(tmp_path: Path) -> None:
+    from stage_sim.core.world_loader import load_world_text
+
+    image = np.full((10, 20), 255)
+    image[2:8, 5:15] = 0  # occupied box 10 x 6 px inside a 20 x 10 image
+    save(tmp_path, "margins.png", image)
+    world = load_world_text('model( size [20 10 1] bitmap "margins.png" )\n', tmp_path / "w.world")
+    (warning,) = [w for w in world.warnings if "margins.png" in w.message]
+    assert "10x6 of 20x10" in warning.message and "2.00000 x 1.66667 m" in warning.message
+    assert warning.location is not None and warning.location.line == 1
+    full = np.full((10, 20), 255)
+    full[0, 0] = full[-1, -1] = 0
+    save(tmp_path, "full.png", full)
+    world = load_world_text('model( size [20 10 1] bitmap "full.png" )\n', tmp_path / "w.world")
+    assert not [w for w in world.warnings if "full.png" in w.message]
