@@ -2,7 +2,8 @@
 
 ``stage_sim inspect WORLD [--json]`` shows what the simulator will make of a world: settings, robots in
 stageros order, rangers, the static obstacles and every warning. Exit status 0 on success, 2 when the
-world cannot be loaded (the message, with file:line:column, goes to stderr). New subcommands register in
+world cannot be loaded (the message, with file:line:column, goes to stderr). ``stage_sim render WORLD -o
+out.png`` draws it (``-o out.gif`` records a run), with the same exit status. New subcommands register in
 :data:`COMMANDS`.
 """
 
@@ -14,12 +15,15 @@ import math
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from stage_sim.core.body_geometry import global_poses
 from stage_sim.core.errors import WorldError
 from stage_sim.core.world_description import Model, Pose, WorldDescription
 from stage_sim.core.world_loader import load_world
+
+if TYPE_CHECKING:
+    from stage_sim.core.simulation import Simulation
 
 
 def resolve_world(name: str) -> Path:
@@ -194,8 +198,122 @@ def _add_inspect(subparsers: Any) -> None:
     parser.set_defaults(run=_inspect)
 
 
-COMMANDS: list[Callable[[Any], None]] = [_add_inspect]
-"""Each entry adds one subcommand and sets ``run``; a ``render`` command plugs in here."""
+STRAIGHT_SPEED = 0.3
+"""m/s of ``render --controller straight``: every robot drives straight ahead until something stops it."""
+
+
+def _render(args: argparse.Namespace) -> int:
+    from stage_sim.core.simulation import Simulation
+    from stage_sim.rendering.recorder import Recorder
+
+    world = resolve_world(args.world)
+    sim = Simulation.from_world(world, seed=args.seed)
+    output = args.output or Path(f"{world.stem}.png")
+    try:
+        recorder = Recorder(
+            sim, output, every_s=args.record_every, fps=args.record_fps, trail_s=args.trail,
+            scale=args.scale, lasers=not args.no_lasers, grid=args.grid,
+        )
+    except ValueError as exc:
+        print(f"stage_sim render: {exc}", file=sys.stderr)
+        return 2
+    drive = _CONTROLLERS[args.controller](sim, args.seed)
+    for _ in range(args.steps):
+        drive()
+        sim.step()
+        recorder.capture_if_due()
+    try:
+        recorder.close()
+    except OSError as exc:
+        print(f"stage_sim render: cannot write {output}: {exc}", file=sys.stderr)
+        return 1
+    print(f"{output}: {recorder.frame_count} frame(s) up to sim time {sim.sim_time:g} s")
+    return 0
+
+
+def _straight(sim: Simulation, seed: int | None) -> Callable[[], None]:
+    """Every robot commanded straight ahead once (commands persist; the CLI's simulation has no watchdog)."""
+    for robot in range(len(sim.robots)):
+        sim.set_velocity(robot, STRAIGHT_SPEED, 0.0, 0.0)
+    return lambda: None
+
+
+def _wander(sim: Simulation, seed: int | None) -> Callable[[], None]:
+    """The ``wander`` node's reactive strategy on every robot's first laser (robots without one stay put)."""
+    from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+
+    drivers = [
+        (robot, Wanderer(WanderConfig(holonomic=robot.settings.drive == "omni"),
+                         None if seed is None else seed + robot.index))
+        for robot in sim.robots if robot.rangers
+    ]
+
+    def decide() -> None:
+        for robot, wanderer in drivers:
+            ranger = robot.rangers[0]
+            sensor = ranger.sensor
+            reading = LaserReading(
+                sim.scans[robot.index][0].ranges, -sensor.fov / 2, sensor.fov / max(sensor.samples - 1, 1),
+                sensor.range_min, sensor.range_max, (*ranger.ray_offset, ranger.ray_yaw),
+            )
+            pose = tuple(float(v) for v in sim.odometry_poses[robot.index])
+            sim.set_velocity(robot.index, *wanderer.decide(reading, sim.sim_time, pose))
+
+    return decide
+
+
+_CONTROLLERS: dict[str, Callable[[Simulation, int | None], Callable[[], None]]] = {
+    "straight": _straight,
+    "wander": _wander,
+}
+
+
+def _add_render(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "render", help="draw a world (optionally after some steps) to a PNG, or record the steps as a GIF",
+        description="Draw the world, its robots and their lasers as Stage's window would. An output ending in "
+        ".gif records a frame every --record-every sim seconds of the --steps run; .png is the final state.",
+    )
+    parser.add_argument("world", help="world file path, or the name of a bundled world")
+    parser.add_argument("-o", "--output", type=_image_path, help="output .png or .gif (default: WORLD-NAME.png)")
+    parser.add_argument("--scale", type=_positive, help="pixels per metre (default: the world's window scale)")
+    parser.add_argument("--no-lasers", action="store_true", help="do not draw the laser rays")
+    parser.add_argument("--grid", action="store_true", help="draw a 1 m grid")
+    parser.add_argument("--seed", type=int, default=0, help="simulation (and wanderer) seed (default: 0)")
+    parser.add_argument("--steps", type=_count, default=0, help="steps to simulate first (default: 0)")
+    parser.add_argument(
+        "--controller", choices=sorted(_CONTROLLERS), default="straight",
+        help=f"who drives during --steps: 'straight' at {STRAIGHT_SPEED} m/s, or the wander node's strategy",
+    )
+    parser.add_argument("--trail", type=float, default=10.0, help="sim seconds of path drawn behind robots (0: none)")
+    parser.add_argument("--record-every", type=_positive, default=0.5, help="sim seconds between GIF frames")
+    parser.add_argument("--record-fps", type=_positive, help="GIF playback frames per second (default: real time)")
+    parser.set_defaults(run=_render)
+
+
+def _image_path(text: str) -> Path:
+    path = Path(text)
+    if path.suffix.lower() not in (".png", ".gif"):
+        raise argparse.ArgumentTypeError(f"'{text}' must end in .png or .gif")
+    return path
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"must be a positive number, not {text}")
+    return value
+
+
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be 0 or more, not {text}")
+    return value
+
+
+COMMANDS: list[Callable[[Any], None]] = [_add_inspect, _add_render]
+"""Each entry adds one subcommand and sets ``run``."""
 
 
 def build_parser() -> argparse.ArgumentParser:

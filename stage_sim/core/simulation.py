@@ -150,6 +150,22 @@ class Simulation:
         """Latest scan of every ranger, per robot (``scans[robot][ranger]``)."""
         return self._sensing.latest
 
+    def render(
+        self, scale: float | None = None, lasers: bool = True, trails: list[np.ndarray] | None = None,
+        grid: bool = False,
+    ) -> np.ndarray:
+        """The world now, as Stage's window shows it: an (H, W, 3) uint8 RGB image with +y up.
+
+        Static world, robot bodies with a heading nose, laser rays to their hits (``lasers``), per robot an
+        (M, 2) array of past positions as a trail (``trails``, NaN rows break a line), a grid, the sim clock
+        and a scale bar. ``scale`` is pixels per metre (default: the world's ``window scale``); the frame
+        covers the static world, so every frame of a run has the same size. Drawn by
+        :mod:`stage_sim.rendering`, imported here so that the core runs without it.
+        """
+        from stage_sim.rendering.frame import render_frame
+
+        return render_frame(self, scale=scale, lasers=lasers, trails=trails, grid=grid)
+
     def state(self, robot: int) -> RobotState:
         """One robot's true pose, odometry, applied velocity and stall flag."""
         return RobotState(
