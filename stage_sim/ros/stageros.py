@@ -11,6 +11,7 @@ between steps), never on the clock the node publishes.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -90,6 +91,7 @@ class StageRos(Node):
         self._last_warning = [-math.inf] * len(robots)
         self.quit_time = description.settings.quit_time
         self.finished = False
+        self._step_listeners: list[Callable[[], None]] = []
         period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0
         self._timer = self.create_timer(
             period, self.step_once, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=autostep)
@@ -146,6 +148,10 @@ class StageRos(Node):
 
     # -- callbacks -----------------------------------------------------------------------------------------
 
+    def add_step_listener(self, listener: Callable[[], None]) -> None:
+        """Call ``listener()`` after every step (after publishing): recorders, statistics, lockstep drivers."""
+        self._step_listeners.append(listener)
+
     def on_command(self, robot: int, twist: Twist) -> None:
         """Accept a finite, sane command; reject anything else with a throttled warning."""
         values = (twist.linear.x, twist.linear.y, twist.angular.z)
@@ -170,6 +176,8 @@ class StageRos(Node):
             return
         self.sim.step()
         self._publish_step()
+        for listener in self._step_listeners:
+            listener()
         if self.quit_time > 0 and self.sim.sim_time >= self.quit_time:
             self.finished = True
             self._timer.cancel()

@@ -160,3 +160,16 @@ def test_quit_time_ends_the_node_cleanly(tmp_path) -> None:
                             timeout=60, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
     assert "quit_time 3 s reached" in result.stderr + result.stdout
+
+
+def test_record_writes_a_gif_of_the_run(tmp_path) -> None:
+    from PIL import Image
+
+    world = tmp_path / "short.world"
+    world.write_text('quit_time 2\nresolution 0.02\nmodel( size [1 1 1] pose [3 0 0 0] )\nposition( pose [0 0 0 0] )\n')
+    gif = tmp_path / "run.gif"
+    result = subprocess.run([str(STAGEROS), "--speedup", "0", "--record", str(gif), "--record-every", "0.5",
+                             str(world)], capture_output=True, text=True, timeout=60, env=dict(os.environ))
+    assert result.returncode == 0, result.stderr
+    with Image.open(gif) as image:
+        assert image.n_frames == 2 / 0.5 + 1  # the start and one frame every 0.5 s up to quit_time
