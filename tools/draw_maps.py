@@ -142,7 +142,7 @@ def draw_corridor() -> Floor:
     """A 16 × 10 m floor of 1.0 m corridors and 0.45 m doors (1.5 widths of a 0.3 m wide robot).
 
     The main corridor runs along y 4.5..5.5; the robot starts at (1.5, 5.0). A 1.0 m corridor branches
-    north at x 7.5..8.5 and turns east along y 8.6..9.6. Rooms open on the corridors through 0.45 m
+    north at x 7.5..8.5 and turns east along y 8.8..9.8. Rooms open on the corridors through 0.45 m
     doors; neighbouring south rooms share 0.5 m doors.
     """
     floor = Floor(16.0, 10.0)
@@ -152,8 +152,8 @@ def draw_corridor() -> Floor:
     floor.hwall(5.5, 8.5, 15.8)
     # The north branch: walls either side, then the east turn under the outer wall.
     floor.vwall(7.35, 5.5, 9.8)
-    floor.vwall(8.5, 5.5, 8.6)
-    floor.hwall(8.45, 8.5, 15.8)
+    floor.vwall(8.5, 5.5, 8.8)
+    floor.hwall(8.65, 8.5, 15.8)
     # South rooms, 3.1 m wide, each with a 0.45 m door onto the corridor.
     for x in (3.0, 6.1, 9.2, 12.3):
         floor.vwall(x, 0.2, 4.35)
@@ -163,10 +163,10 @@ def draw_corridor() -> Floor:
         floor.vdoor(x, 1.5, 0.5)
     # North-west room (west of the branch) and the rooms between the main corridor and the turn.
     floor.hdoor(5.5, 3.5, 0.45)
-    floor.vwall(12.0, 5.65, 8.45)
+    floor.vwall(12.0, 5.65, 8.65)
     for x in (10.0, 13.5):
         floor.hdoor(5.5, x, 0.45)
-        floor.hdoor(8.45, x + 0.5, 0.45)
+        floor.hdoor(8.65, x + 0.5, 0.45)
     # A few obstacles inside rooms.
     floor.box(0.2, 0.2, 1.0, 1.2)
     floor.disk(11.0, 2.0, 0.4)

@@ -79,3 +79,69 @@ def test_trimmed_white_margins_are_warned_about_with_the_resulting_scale(tmp_pat
     save(tmp_path, "full.png", full)
     world = load_world_text('model( size [20 10 1] bitmap "full.png" )\n', tmp_path / "w.world")
     assert not [w for w in world.warnings if "full.png" in w.message]
+
+
+def test_palette_images_use_the_colour_shown_not_the_index(tmp_path: Path) -> None:
+    image = Image.new("P", (3, 1))
+    image.putpalette([255, 255, 255, 0, 0, 0, 0, 0, 255] + [0] * 759)  # index 0 white, 1 black, 2 blue
+    image.putdata([0, 1, 2])
+    image.save(tmp_path / "p.png")
+    assert load_stage_bitmap(tmp_path / "p.png").tolist() == [[False, True, True]]
+
+
+def test_grey_alpha_one_bit_and_sixteen_bit_images(tmp_path: Path) -> None:
+    grey_alpha = np.array([[[0, 0], [255, 255], [127, 255], [128, 0]]])
+    assert load_stage_bitmap(save(tmp_path, "la.png", grey_alpha, "LA")).tolist() == [[True, False, True, False]]
+    Image.fromarray(np.array([[True, False]])).save(tmp_path / "bits.png")  # mode "1": True = white
+    assert load_stage_bitmap(tmp_path / "bits.png").tolist() == [[False, True]]
+    wide = Image.fromarray(np.array([[0, 32767, 32768, 65535]], dtype=np.uint16))
+    wide.save(tmp_path / "wide.png")  # libpng's strip_16 keeps the high byte: 32767 -> 127
+    assert load_stage_bitmap(tmp_path / "wide.png").tolist() == [[True, True, False, False]]
+
+
+@pytest.mark.parametrize("suffix", [".jpg", ".gif", ".bmp", ".pnm", ".tif"])
+def test_other_image_formats(tmp_path: Path, suffix: str) -> None:
+    image = np.full((16, 32), 255)
+    image[:, :16] = 0  # large blocks so lossy JPEG keeps the halves apart
+    mask = load_stage_bitmap(save(tmp_path, "img" + suffix, image))
+    assert mask[:, :14].all() and not mask[:, 18:].any()
+
+
+def test_ascii_pgm_with_small_maxval(tmp_path: Path) -> None:
+    path = tmp_path / "a.pgm"
+    path.write_text("P2\n# comment\n3 1\n15\n0 7 15\n")  # 7/15 of white is 119: occupied
+    assert load_stage_bitmap(path).tolist() == [[True, True, False]]
+
+
+def test_a_directory_is_not_a_bitmap(tmp_path: Path) -> None:
+    where = SourceLocation("w.world", 3, 1)
+    with pytest.raises(WorldError) as error:
+        load_stage_bitmap(tmp_path, where)
+    assert error.value.location == where and str(tmp_path) in str(error.value)
+
+
+def test_missing_bitmap_message_and_location(tmp_path: Path) -> None:
+    where = SourceLocation("w.world", 7, 2)
+    with pytest.raises(WorldError) as error:
+        load_stage_bitmap(tmp_path / "x" / "gone.png", where)
+    assert error.value.what == f"bitmap not found: {tmp_path / 'x' / 'gone.png'}"
+    assert error.value.location == where
+
+
+def test_truncated_image_is_a_world_error_naming_the_file(tmp_path: Path) -> None:
+    good = save(tmp_path, "t.png", np.random.default_rng(0).integers(0, 256, (64, 64)))
+    truncated = tmp_path / "truncated.png"
+    truncated.write_bytes(good.read_bytes()[:200])
+    with pytest.raises(WorldError, match=r"truncated\.png"):
+        load_stage_bitmap(truncated)
+
+
+def test_bounding_box_fields_and_full_image() -> None:
+    mask = np.ones((4, 5), dtype=bool)
+    box = occupied_bounding_box(mask)
+    assert box is not None
+    assert (box.row0, box.row1, box.col0, box.col1) == (0, 4, 0, 5)
+    assert (box.height, box.width) == (4, 5)
+    single = np.zeros((4, 5), dtype=bool)
+    single[3, 4] = True
+    assert occupied_bounding_box(single) == (3, 4, 4, 5)

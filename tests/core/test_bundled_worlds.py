@@ -69,3 +69,29 @@ def test_yaml_world_matches_the_bitmap_world() -> None:
     differ = np.count_nonzero(bitmap.occupied != yaml.occupied)
     # only the outermost cells differ (Stage's boundary walls and pixel-centre rounding at the border)
     assert differ < 0.03 * bitmap.occupied_cell_count
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_every_robot_starts_well_clear_of_the_map(name: str) -> None:
+    world = load_world(data_root() / "worlds" / name)
+    (floor,) = [m for m in world.models if m.bitmap is not None]
+    bitmap = floor.bitmap
+    assert bitmap is not None
+    height, width = bitmap.occupied.shape
+    if bitmap.grid is not None:  # map_server placement: the YAML origin in the model frame
+        resolution = bitmap.grid.resolution
+        left, bottom = floor.pose.x + bitmap.grid.origin[0], floor.pose.y + bitmap.grid.origin[1]
+    else:  # Stage placement: the (full, outer-walled) image stretched to size and centred on the pose
+        resolution = floor.size[0] / width
+        assert floor.size[1] / height == pytest.approx(resolution)
+        left, bottom = floor.pose.x - floor.size[0] / 2, floor.pose.y - floor.size[1] / 2
+    rows, cols = np.nonzero(bitmap.occupied)
+    x0, y1 = left + cols * resolution, bottom + (height - rows) * resolution
+    robots = world.robots()
+    for robot in robots:
+        dx = np.maximum(np.maximum(x0 - robot.pose.x, robot.pose.x - x0 - resolution), 0.0)
+        dy = np.maximum(np.maximum(y1 - resolution - robot.pose.y, robot.pose.y - y1), 0.0)
+        assert np.sqrt(dx * dx + dy * dy).min() >= 0.45, robot.name
+    for i, a in enumerate(robots):
+        for b in robots[i + 1 :]:
+            assert math.hypot(a.pose.x - b.pose.x, a.pose.y - b.pose.y) > 2.0
