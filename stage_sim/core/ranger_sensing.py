@@ -74,15 +74,21 @@ class RangerSensing:
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
+        self._stale = True
 
     def reset(self, rng: np.random.Generator) -> None:
         """Use ``rng`` for the noise from now on."""
         self._rng = rng
 
-    def sense(self, poses: np.ndarray, time: float, force: bool = False) -> None:
-        """Cast the rangers that are due at ``time`` (all of them with ``force``) from robot ``poses``."""
+    def invalidate(self) -> None:
+        """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
+        self._stale = True
+
+    def sense(self, poses: np.ndarray, time: float) -> None:
+        """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``."""
         now_us = round(time * 1e6)
-        due = np.ones(len(self._rangers), dtype=bool) if force else (now_us - self._last_us) >= self._interval_us
+        due = np.full(len(self._rangers), self._stale) | ((now_us - self._last_us) >= self._interval_us)
+        self._stale = False
         if not due.any():
             return
         self._last_us[due] = now_us

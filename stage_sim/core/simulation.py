@@ -87,17 +87,19 @@ class Simulation:
     # -- lifecycle -------------------------------------------------------------------------------------
 
     def reset(self, seed: int | None = None) -> None:
-        """Back to the start: time 0, start poses, no motion; a new seed redraws the random parts."""
+        """Back to the start: time 0, start poses, no motion, fresh scans; a new seed redraws the random parts."""
         self.rng = np.random.default_rng(seed)
         self.sim_time_us = 0
         self.odom_errors = draw_odom_errors([r.settings.odom_error for r in self.robots], self.rng)
         self._sensing.reset(self.rng)
         self.reset_positions()
+        self._sensing.sense(self.true_poses, self.sim_time)
 
     def reset_positions(self) -> None:
         """What stageros' ``reset_positions`` does here: start poses, no stall, no velocity, fresh odometry.
 
-        Sim time and the random state carry on. Call it between steps (the ROS layer does)."""
+        Sim time and the random state carry on; every laser scans again at the next step (not now, so that a
+        storm of resets costs nothing). Call it between steps (the ROS layer does)."""
         n = len(self.robots)
         self.true_poses = self._start.copy()
         self.commands = np.zeros((n, 3))
@@ -106,7 +108,7 @@ class Simulation:
         self.last_command_us = np.full(n, self.sim_time_us, dtype=np.int64)
         self.odometry_poses = np.where(
             self._uses_odom[:, None], relative_pose(self._start, self._odom_origin), self._start)
-        self._sensing.sense(self.true_poses, self.sim_time, force=True)
+        self._sensing.invalidate()
 
     # -- inputs ----------------------------------------------------------------------------------------
 

@@ -99,16 +99,33 @@ def test_console_script_scans_drives_resets_and_exits_on_ctrl_c(ros_context, exe
     assert code == 0, output
 
 
+SLOW_SUBSCRIBER = """
+import time, rclpy
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
+rclpy.init()
+node = rclpy.create_node("slow_subscriber")
+node.create_subscription(LaserScan, "base_scan", lambda m: time.sleep(1.0), 10)
+node.create_subscription(TFMessage, "/tf", lambda m: time.sleep(1.0), 10)
+rclpy.spin(node)
+"""
+
+
 @pytest.mark.slow
-def test_a_flood_of_commands_neither_slows_the_clock_nor_grows_memory(ros_context, executor, tmp_path) -> None:
+def test_floods_reset_storms_and_slow_subscribers_neither_slow_the_clock_nor_grow_memory(
+    ros_context, executor, tmp_path
+) -> None:
     process = start_stageros(tmp_path)  # real time: 10 steps per wall second
+    slow = subprocess.Popen([sys.executable, "-c", SLOW_SUBSCRIBER], env=dict(os.environ))
     try:
         node = Node("flooder", context=ros_context)
         executor.add_node(node)
         clock: list[tuple[float, float]] = []
         node.create_subscription(Clock, "/clock", lambda m: clock.append((time.monotonic(), seconds(m.clock))), 100)
         cmd = node.create_publisher(Twist, "cmd_vel", 10)
+        reset = node.create_client(Empty, "reset_positions")
         assert spin_until(executor, lambda: len(clock) >= 5 and cmd.get_subscription_count() > 0, timeout_s=30)
+        assert reset.wait_for_service(timeout_sec=10)
         rss_before = rss_mb(process.pid)
         values = [math.nan, 1e9, -math.inf, 0.3, 0.0, 5e3, 0.5]
         messages = [Twist() for _ in values]
@@ -116,13 +133,16 @@ def test_a_flood_of_commands_neither_slows_the_clock_nor_grows_memory(ros_contex
             msg.linear.x = value
             msg.angular.z = -value if math.isfinite(value) else value
         window_start = len(clock)
-        sent, start = 0, time.monotonic()
+        sent, resets, start = 0, [], time.monotonic()
         while (now := time.monotonic()) - start < 10.0:
             while sent < (now - start) * 2000:
                 cmd.publish(messages[sent % len(messages)])
                 sent += 1
+            if len(resets) < (now - start) * 50:  # a reset storm: 50 calls per second
+                resets.append(reset.call_async(Empty.Request()))
             executor.spin_once(timeout_sec=0)
         assert sent >= 19_000
+        assert spin_until(executor, lambda: all(f.done() for f in resets), timeout_s=10)
         window = clock[window_start:]
         (wall0, sim0), (wall1, sim1) = window[0], window[-1]
         rate = (sim1 - sim0) / (wall1 - wall0)
@@ -130,6 +150,8 @@ def test_a_flood_of_commands_neither_slows_the_clock_nor_grows_memory(ros_contex
         growth = rss_mb(process.pid) - rss_before
         assert growth < 20, f"resident memory grew by {growth:.1f} MB"
     finally:
+        slow.kill()
+        slow.wait()
         code, output = stop(process)
     assert code == 0, output
     assert "rejected command" in output
