@@ -283,3 +283,35 @@ def test_bad_commands_are_rejected_and_the_previous_one_kept(ros_context, execut
         assert sim.sim.commands[0][0] == 0.3
     sim.step_once()
     assert sim.sim.true_poses[0][0] == pytest.approx(2.03)
+
+
+def test_stamped_velocity_and_world_file_parameter(ros_context, executor, tmp_path) -> None:
+    from geometry_msgs.msg import TwistStamped
+
+    world = write_world(tmp_path, 'bot( pose [2 5 0 0] )')
+    overrides = [Parameter("world_file", value=str(world)), Parameter("use_stamped_velocity", value=True)]
+    sim = StageRos(None, autostep=False, context=ros_context, parameter_overrides=overrides)
+    executor.add_node(sim)
+    probe = Probe(ros_context, executor)
+    driver = probe.node.create_publisher(TwistStamped, "cmd_vel", 10)
+    assert spin_until(executor, lambda: driver.get_subscription_count() > 0)
+    cmd = TwistStamped()
+    cmd.twist.linear.x = 0.4
+    driver.publish(cmd)
+    assert spin_until(executor, lambda: sim.sim.commands[0][0] == pytest.approx(0.4))
+    sim.step_once()
+    assert sim.sim.true_poses[0][0] == pytest.approx(2.04)
+
+
+def test_seed_parameter_fixes_the_drawn_odometry_error(ros_context, executor, tmp_path) -> None:
+    world = tmp_path / "drawn.world"
+    world.write_text(WORLD.replace('odom_error [0 0 0 0] ', '').format(body="") + 'bot( pose [2 5 0 0] )')
+    a = StageRos(str(world), autostep=False, node_name="a", context=ros_context,
+                 parameter_overrides=[Parameter("seed", value=4)])
+    b = StageRos(str(world), autostep=False, node_name="b", context=ros_context,
+                 parameter_overrides=[Parameter("seed", value=4)])
+    c = StageRos(str(world), autostep=False, node_name="c", context=ros_context, seed=5)
+    assert np.array_equal(a.sim.odom_errors, b.sim.odom_errors)
+    assert not np.array_equal(a.sim.odom_errors, c.sim.odom_errors)
+    for node in (a, b, c):
+        node.destroy_node()
