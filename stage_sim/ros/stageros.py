@@ -20,7 +20,9 @@ from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import LaserScan
@@ -42,6 +44,11 @@ WARNING_THROTTLE_S = 5.0
 WORLD_FRAME = "world"
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# rclpy gives every publisher and subscription default QoS-event handlers, each a waitable the executor
+# re-adds to its wait set before every callback: with hundreds of per-robot endpoints that cost more than
+# the simulation step. Per-robot endpoints go without them; the world-wide ones keep the default warnings.
+NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
+NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -109,16 +116,18 @@ class StageRos(Node):
         self.map_pub = self.create_publisher(OccupancyGridMsg, "/map", LATCHED) if self.publish_map else None
         self.odom_pubs, self.truth_pubs, self.stall_pubs, self.scan_pubs = [], [], [], []
         for index, names in enumerate(self.names):
-            self.odom_pubs.append(self.create_publisher(Odometry, names.odom, RELIABLE_10))
-            self.truth_pubs.append(self.create_publisher(Odometry, names.ground_truth, RELIABLE_10))
-            self.stall_pubs.append(self.create_publisher(Bool, names.stall, RELIABLE_10))
-            self.scan_pubs.append([self.create_publisher(LaserScan, topic, RELIABLE_10) for topic in names.scans])
+            self.odom_pubs.append(self._robot_publisher(Odometry, names.odom))
+            self.truth_pubs.append(self._robot_publisher(Odometry, names.ground_truth))
+            self.stall_pubs.append(self._robot_publisher(Bool, names.stall))
+            self.scan_pubs.append([self._robot_publisher(LaserScan, topic) for topic in names.scans])
             if stamped:
                 self.create_subscription(
-                    TwistStamped, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg.twist), RELIABLE_10)
+                    TwistStamped, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg.twist), RELIABLE_10,
+                    event_callbacks=NO_SUB_EVENTS)
             else:
                 self.create_subscription(
-                    Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10)
+                    Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10,
+                    event_callbacks=NO_SUB_EVENTS)
         self.create_service(Empty, "reset_positions", self.on_reset)
         # Messages are built once and refilled every step: publishing serialises them, so reuse is safe.
         self._out = [
@@ -132,6 +141,9 @@ class StageRos(Node):
             for robot, names in zip(self.sim.robots, self.names, strict=True)
         ]
         self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
+
+    def _robot_publisher(self, msg_type: type, topic: str) -> Publisher:
+        return self.create_publisher(msg_type, topic, RELIABLE_10, event_callbacks=NO_PUB_EVENTS)
 
     def _publish_static(self) -> None:
         """One latched /tf_static message with every robot's fixed frames (and /map if asked)."""
