@@ -1,22 +1,39 @@
-"""In-process sessions for the launch scripts: the simulator and its controllers in one executor.
+"""In-process sessions for the launch scripts: the simulator and one wanderer per robot in one executor.
 
-Running ``StageRos`` and the wanderers in one process and one executor avoids discovery delays and, with
-``speedup <= 0``, allows *lockstep*: step the world, then spin until every wanderer has answered that
-step's scan with a command the simulator received, so a seed gives the same run every time. With
-``speedup > 0`` the simulator's own wall timer paces the steps. Either way :class:`RunStats` samples the
-ground truth after every step and yields the per-robot JSON summaries the scripts print at exit.
+One process and one executor spare the launch machinery and, with ``speedup <= 0``, allow *lockstep*: step
+the world, then spin until every wanderer has answered that step's scan with a command the simulator has
+received (or a short wall timeout passes), so a seed gives the same run every time. With ``speedup > 0`` a
+steady wall timer paces the steps at ``interval_sim / speedup``, as the simulator's own would. Either way
+:class:`RunStats` samples the ground truth after every step and gives the JSON summaries printed at exit.
 """
 
 from __future__ import annotations
 
+import argparse
+import contextlib
+import json
 import math
+import signal
+import sys
+import time
+from collections.abc import Iterator
 
 import numpy as np
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.signals import SignalHandlerOptions
 
+from stage_sim.core.errors import WorldError
 from stage_sim.core.simulation import Simulation
+from stage_sim.ros.stageros import StageRos
+from stage_sim.ros.wander import Wander
 
 STOP_SPEED = 0.01  # m/s and rad/s below which a robot counts as standing still
-LOCKSTEP_TIMEOUT_S = 0.5  # wall seconds to wait for the controllers' answers before stepping anyway
+LOCKSTEP_TIMEOUT_S = 0.5  # wall seconds to wait for the wanderers' answers before stepping anyway
+CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subscriptions to match
 
 
 class RunStats:
@@ -123,3 +140,118 @@ def _connected(free: np.ndarray, seeds: list[tuple[int, int]]) -> np.ndarray:
         if np.array_equal(grown, region):
             return region
         region = grown
+
+
+class WanderSession:
+    """A simulator and a wanderer per robot (namespaced like the simulator's topics), in one executor."""
+
+    def __init__(self, world: str, speedup: float, seed: int | None, context: Context | None = None) -> None:
+        self.stage = StageRos(world, speedup=speedup, seed=seed, autostep=False, context=context)
+        sim = self.stage.sim
+        self.wanderers = []
+        for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
+            prefix = names.cmd_vel[: -len("cmd_vel")]
+            remap = ["--ros-args", "-r", f"base_scan:={names.scans[0][len(prefix):]}"] if robot.rangers else None
+            overrides = [Parameter("holonomic", value=robot.settings.drive == "omni")]
+            if seed is not None:
+                overrides.append(Parameter("seed", value=seed * 100 + index))
+            self.wanderers.append(Wander(
+                f"wander_{index}", namespace=prefix.rstrip("/") or None, context=context, cli_args=remap,
+                parameter_overrides=overrides))
+        self.executor = SingleThreadedExecutor(context=context)
+        for node in (self.stage, *self.wanderers):
+            self.executor.add_node(node)
+        self.stats = RunStats(sim)
+
+    def run(self, duration: float | None = None) -> None:
+        """Step until ``duration`` sim seconds, the world's quit_time, or Ctrl-C (KeyboardInterrupt)."""
+        self._connect()
+        stage, sim = self.stage, self.stage.sim
+        if stage.speedup > 0:
+            stage.create_timer(sim.interval / stage.speedup, self._step, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        while not stage.finished and (duration is None or sim.sim_time < duration - 1e-9):
+            if stage.speedup > 0:
+                self.executor.spin_once(timeout_sec=0.1)
+            else:
+                self._step()
+                self._await_answers()
+
+    def summaries(self) -> list[dict]:
+        """The per-robot JSON summaries, named after the robots' models."""
+        return self.stats.summaries([robot.name or f"robot_{robot.index}" for robot in self.stage.sim.robots])
+
+    def close(self) -> None:
+        """Stop the robots and destroy every node."""
+        for node in (*self.wanderers, self.stage):
+            self.executor.remove_node(node)
+            node.destroy_node()
+        self.executor.shutdown(timeout_sec=1.0)
+
+    def _step(self) -> None:
+        self.stage.step_once()
+        self.stats.update()
+
+    def _connect(self) -> None:
+        """Spin until every scan, odometry and command topic has matched (discovery, even in-process)."""
+        stage = self.stage
+        deadline = time.monotonic() + CONNECT_TIMEOUT_S
+        while time.monotonic() < deadline and not all(
+            stage.odom_pubs[i].get_subscription_count() and w.publisher.get_subscription_count()
+            and all(p.get_subscription_count() for p in stage.scan_pubs[i][:1])
+            for i, w in enumerate(self.wanderers)
+        ):
+            self.executor.spin_once(timeout_sec=0.01)
+
+    def _await_answers(self) -> None:
+        """Lockstep: spin until each robot that got a scan this step has had its command accepted."""
+        sim = self.stage.sim
+        waiting = [i for i in range(len(self.wanderers)) if any(s.stamp == sim.sim_time for s in sim.scans[i])]
+        deadline = time.monotonic() + LOCKSTEP_TIMEOUT_S
+        while any(sim.last_command_us[i] != sim.sim_time_us for i in waiting) and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.01)
+
+
+@contextlib.contextmanager
+def sigterm_interrupts() -> Iterator[None]:
+    """Let SIGTERM end a session like Ctrl-C, so the summaries are still printed."""
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def parse_args(argv: list[str], prog: str, default_world: str, description: str) -> argparse.Namespace:
+    """The launch scripts' common options."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser.add_argument("world", nargs="?", default=default_world,
+                        help=f"a .world file or a bundled world's name (default {default_world})")
+    parser.add_argument("--speedup", type=float, default=1.0,
+                        help="sim seconds per wall second (default 1); <= 0: lockstep, as fast as possible")
+    parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")
+    parser.add_argument("--seed", type=int, default=None, help="seed of the simulator and the wanderers")
+    return parser.parse_args(argv)
+
+
+def wander_main(argv: list[str], prog: str, default_world: str, description: str) -> int:
+    """Run a wander session and print one JSON summary per robot at the end (also after Ctrl-C)."""
+    args = parse_args(argv, prog, default_world, description)
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    session = None
+    try:
+        with sigterm_interrupts():
+            session = WanderSession(args.world, args.speedup, args.seed)
+            with contextlib.suppress(KeyboardInterrupt):
+                session.run(args.duration)
+            for summary in session.summaries():
+                print(json.dumps(summary), flush=True)
+        return 0
+    except (WorldError, FileNotFoundError, ValueError) as error:
+        print(f"{prog}: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        if session is not None:
+            session.close()
+        rclpy.try_shutdown()

@@ -1,0 +1,20 @@
+#!/usr/bin/env python3
+"""Simulator + wanderer (the course's ``reactive.launch``), in one process, without the launch package.
+
+``python launch_scripts/reactive.py [WORLD] [--speedup X] [--duration S] [--seed N]`` runs the world
+(default ``rooms.world``) with a ``wander`` node per robot until ``--duration`` sim seconds or Ctrl-C, then
+prints one JSON summary per robot: sim_seconds, distance_m, stall_events, longest_stop_s, coverage.
+``--speedup 0`` runs in lockstep as fast as possible, reproducibly for a given ``--seed``.
+"""
+
+import os
+import sys
+from pathlib import Path
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
+
+from stage_sim.ros.session import wander_main
+
+if __name__ == "__main__":
+    sys.exit(wander_main(sys.argv[1:], "reactive.py", "rooms.world", __doc__.splitlines()[0]))

@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Simulator + keyboard teleop (the course's ``teleop.launch``), in one process, without the launch package.
+
+``python launch_scripts/teleop.py [WORLD] [--speedup X] [--duration S] [--seed N]`` runs the world (default
+``rooms.world``) and drives its first robot with teleop_twist_keyboard's keys typed on this terminal
+(``u i o / j k l / m , .``; Ctrl-C quits) until Ctrl-C or ``--duration`` sim seconds.
+"""
+
+import os
+import sys
+import threading
+from pathlib import Path
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+
+from stage_sim.core.errors import WorldError
+from stage_sim.ros.session import parse_args, sigterm_interrupts
+from stage_sim.ros.stageros import StageRos
+from stage_sim.ros.teleop import KeyReader, TeleopTwistKeyboard
+
+
+def main(argv: list[str]) -> int:
+    """Spin the simulator in a thread while the teleop reads the keyboard; 0 on Ctrl-C or at the duration."""
+    args = parse_args(argv, "teleop.py", "rooms.world", __doc__.splitlines()[0])
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    nodes = []
+    executor = SingleThreadedExecutor()
+    done = threading.Event()
+
+    def spin() -> None:
+        """Step the world until told to stop, the duration or the world's quit_time; then end the teleop too."""
+        while not done.is_set() and not stage.finished and (
+                args.duration is None or stage.sim.sim_time < args.duration - 1e-9):
+            executor.spin_once(timeout_sec=0.1)
+        rclpy.try_shutdown()  # ends the teleop's key loop within its poll interval
+
+    try:
+        with sigterm_interrupts():
+            stage = StageRos(args.world, speedup=args.speedup, seed=args.seed)
+            nodes.append(stage)
+            namespace = stage.names[0].cmd_vel[: -len("cmd_vel")].rstrip("/") if stage.names else ""
+            teleop = TeleopTwistKeyboard(namespace=namespace or None)
+            nodes.append(teleop)
+            for node in nodes:
+                executor.add_node(node)
+            spinner = threading.Thread(target=spin, name="stage-spin", daemon=True)
+            spinner.start()
+            with KeyReader(sys.stdin) as keys:
+                teleop.run(keys)
+            done.set()
+            spinner.join()
+        return 0
+    except (WorldError, FileNotFoundError, ValueError) as error:
+        print(f"teleop.py: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        done.set()
+        for node in nodes:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,393 @@
+"""Reactive wandering for a laser-equipped mobile robot: the decision logic of the ``wander`` node, ROS-free.
+
+Per scan, :class:`Wanderer` (1) turns the scan into obstacle points and keeps, in the odometry frame, the
+nearby points that have left the laser's field of view (the rear is blind, yet turning in place swings the
+rear corners through it), each with a safety allowance that grows with the odometry error accumulated since
+it was seen; (2) picks a desired heading: *explore* heads for the open direction with the most space the
+robot has not yet passed near (a coarse :class:`VisitMap` of the odometry frame, forgotten after a while so
+that wandering never ends), and when none is in view a *tour* takes the open direction nearest round to one
+side (a left- or right-hand rule: through every door and round every room), the side redrawn by a seeded
+generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
+body, simulated along the command's arc, keeps clear of every point (a dynamic-window check). No command is
+ever zero, so the robot never stands still, and none brings the body closer to a point than
+``safety_distance`` (or than it already is), so it never drives into what it has seen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+# Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
+CHECK_TIMES = np.array([0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.1, 1.5])
+SAFE_TIMES = np.concatenate([[0.0], CHECK_TIMES[:-1]])  # how long an arc stays clear if it hits at index k
+TURN_CHECK = 4  # index in CHECK_TIMES of the pose (0.6 s) whose turning circle should be clear
+ADMISSIBLE_S = 0.4  # an arc must stay clear this long to be chosen when any does
+LOOK_AHEAD_S = 1.0  # heading and progress of a candidate are judged at this time
+TOLERANCE = 0.005  # m a point already inside the safety distance may come closer (sensor quantisation)
+MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
+CLEARANCE_CAP = 0.15  # m of clearance beyond which more is no better
+PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
+ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net turn (m/m, rad/rad) since a point was seen
+MAX_ALLOWANCE = 0.1  # m: remembered points less certain than this are forgotten
+OPEN_RANGE = 1.5  # m of free corridor ahead for an escape direction to count as open
+BLOCKED_RANGE = 0.7  # m of free corridor below which an explore heading is abandoned
+TOUR_RANGE = 1.0  # m of free corridor for a direction to count as open to the tour
+TOUR_GAP = 0.17  # m beside the body that the tour's corridor keeps free: room to turn in place next to a wall
+WALL_NEAR = 1.2  # m: a tour with no wall this near on its side goes straight on to find one
+BEARINGS = np.radians(np.arange(-110, 111, 5))  # directions weighed for exploring and escaping
+SAMPLES = np.arange(0.5, 5.01, 0.5)  # m along a direction where unvisited space is looked for
+NEW_SPACE = 2.0  # m of unvisited space in a direction that makes it worth exploring
+LOOK_S = 0.5  # s between looks for new space
+STUCK_WINDOW_S = 12.0  # no 0.5 m of progress within this long → escape along a new heading
+ESCAPE_S = 4.0  # s spent heading away from a dead end or a stuck spot
+BACKING_S = 1.0  # s a reverse manoeuvre is kept up before driving forward again
+
+
+@dataclass(frozen=True)
+class WanderConfig:
+    """Tunable parameters; the defaults suit the bundled worlds' course robot (0.46 × 0.3 m body)."""
+
+    forward_speed: float = 0.7  # m/s in the open
+    safety_distance: float = 0.04  # m kept between the body rectangle and any obstacle point
+    turn_rate: float = 1.2  # rad/s at most
+    holonomic: bool = False  # also try sideways commands (omni drive)
+    # The body as rectangles (x_min, x_max, y_min, y_max) in the robot frame: chassis and laser housing.
+    footprint: tuple[tuple[float, float, float, float], ...] = ((-0.2, 0.2, -0.15, 0.15), (0.2, 0.26, -0.03, 0.03))
+    memory_radius: float = 1.5  # m around the robot within which out-of-view points are remembered
+    tour_s: tuple[float, float] = (40.0, 120.0)  # duration range of a tour before its side is redrawn
+    visit_reach: float = 1.0  # m around the path that counts as visited
+    visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
+
+
+@dataclass(frozen=True)
+class LaserReading:
+    """One scan as the sensor reports it, plus where the laser sits on the robot (x, y, yaw)."""
+
+    ranges: np.ndarray
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    laser_pose: tuple[float, float, float] = (0.23, 0.0, 0.0)
+
+    def points(self) -> np.ndarray:
+        """Hit points (P, 2) in the robot frame; misses (range_max, inf, NaN) are dropped."""
+        ranges = np.asarray(self.ranges, dtype=np.float64)
+        hit = np.isfinite(ranges) & (ranges >= self.range_min) & (ranges < self.range_max)
+        x, y, yaw = self.laser_pose
+        angles = yaw + self.angle_min + np.flatnonzero(hit) * self.angle_increment
+        return np.stack([x + ranges[hit] * np.cos(angles), y + ranges[hit] * np.sin(angles)], axis=-1)
+
+    def outside_view(self, points: np.ndarray) -> np.ndarray:
+        """Which robot-frame points lie outside the laser's field of view (the blind sector)."""
+        x, y, yaw = self.laser_pose
+        half_fov = (len(self.ranges) - 1) * self.angle_increment / 2
+        off_axis = wrap(np.arctan2(points[:, 1] - y, points[:, 0] - x) - yaw - self.angle_min - half_fov)
+        return np.abs(off_axis) > half_fov + 1e-3
+
+
+def wrap(angle: float | np.ndarray) -> float | np.ndarray:
+    """Angle(s) in [-π, π)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def _compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool = False) -> np.ndarray:
+    """Points (P, 2) given in the frame at ``pose`` in the outer frame, or the reverse with ``inverse``."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    if inverse:
+        dx, dy = points[:, 0] - pose[0], points[:, 1] - pose[1]
+        return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
+    return np.stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]], -1)
+
+
+def arc_poses(commands: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Exact poses (C, T, 3) reached from the origin holding each body twist (vx, vy, wz) for ``times``."""
+    vx, vy, w = (commands[:, k, None] for k in range(3))
+    yaw = w * times
+    small = np.abs(w) < 1e-9
+    safe_w = np.where(small, 1.0, w)
+    sin_term = np.where(small, times, np.sin(yaw) / safe_w)
+    cos_term = np.where(small, 0.0, (1 - np.cos(yaw)) / safe_w)
+    return np.stack([vx * sin_term - vy * cos_term, vx * cos_term + vy * sin_term, yaw], axis=-1)
+
+
+def candidate_commands(config: WanderConfig) -> np.ndarray:
+    """The fixed command set (C, 3): forward arcs, turns in place, a slow reverse; never all zero."""
+    turns = np.linspace(-config.turn_rate, config.turn_rate, 13)
+    speeds = [-0.15, *np.linspace(0.0, config.forward_speed, 7)]
+    commands = [(v, 0.0, w) for v in speeds for w in turns]
+    if config.holonomic:
+        side = min(0.3, config.forward_speed)
+        commands += [(v, vy, w) for v in (0.0, side) for vy in (-side, side) for w in (-0.4, 0.0, 0.4)]
+    array = np.array(commands)
+    return array[np.any(array != 0.0, axis=1)]
+
+
+class VisitMap:
+    """When each cell of a coarse grid (odometry frame, growing as needed) last came within reach of the robot."""
+
+    def __init__(self, cell: float = 0.5, reach: float = 1.0) -> None:
+        self.cell = cell
+        r = math.ceil(reach / cell)
+        di, dj = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1), indexing="ij")
+        inside = np.hypot(di, dj) * cell <= reach
+        self._disc = (di[inside], dj[inside])
+        self._low = np.zeros(2, dtype=np.int64)
+        self.times = np.full((0, 0), -np.inf)
+
+    def stamp(self, x: float, y: float, time: float) -> None:
+        """Mark the cells within reach of (x, y) as visited at ``time``."""
+        i, j = math.floor(x / self.cell), math.floor(y / self.cell)
+        r = int(self._disc[0].max())
+        low, high = self._low, self._low + self.times.shape
+        if i - r < low[0] or j - r < low[1] or i + r >= high[0] or j + r >= high[1]:
+            new_low = np.minimum(low, (i - r - 20, j - r - 20))
+            new_high = np.maximum(high, (i + r + 21, j + r + 21))
+            grown = np.full(new_high - new_low, -np.inf)
+            offset = low - new_low
+            grown[offset[0]: offset[0] + self.times.shape[0], offset[1]: offset[1] + self.times.shape[1]] = self.times
+            self.times, self._low = grown, new_low
+        self.times[self._disc[0] + i - self._low[0], self._disc[1] + j - self._low[1]] = time
+
+    def visited_since(self, xy: np.ndarray, since: float) -> np.ndarray:
+        """Whether each point (..., 2) lies in a cell visited at or after ``since``."""
+        index = np.floor(xy / self.cell).astype(np.int64) - self._low
+        inside = np.all((index >= 0) & (index < self.times.shape), axis=-1)
+        clipped = np.clip(index, 0, np.maximum(np.array(self.times.shape) - 1, 0))
+        return inside & (self.times[clipped[..., 0], clipped[..., 1]] >= since) if self.times.size else inside
+
+
+class Wanderer:
+    """Decides a velocity command per scan; the same seed and inputs give the same commands."""
+
+    def __init__(self, config: WanderConfig | None = None, seed: int | None = None) -> None:
+        self.config = config or WanderConfig()
+        self.rng = np.random.default_rng(seed)
+        self.commands = candidate_commands(self.config)
+        self._poses = arc_poses(self.commands, CHECK_TIMES)
+        self._look = arc_poses(self.commands, np.array([LOOK_AHEAD_S]))[:, 0]
+        boxes = np.array(self.config.footprint, dtype=np.float64).reshape(-1, 4)
+        self._boxes = boxes
+        self._front = float(boxes[:, 1].max())
+        self._half_width = float(np.abs(boxes[:, 2:]).max())
+        self._radius = float(np.hypot(np.abs(boxes[:, :2]).max(axis=1), np.abs(boxes[:, 2:]).max(axis=1)).max())
+        # Candidates grouped by linear speed, with how far from the centre a point can matter to them.
+        speeds = np.round(np.hypot(self.commands[:, 0], self.commands[:, 1]), 6)
+        margin = self.config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
+        self._groups = [(v * CHECK_TIMES[-1] + self._radius + margin, np.flatnonzero(speeds == v))
+                        for v in np.unique(speeds)]
+        self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
+        self._odometry = np.zeros(2)  # metres driven and net radians turned so far (odometry errors scale with these)
+        self._pose: tuple[float, float, float] | None = None
+        self._time = 0.0
+        self.command = (0.0, 0.0, 0.0)
+        self.visits = VisitMap(reach=self.config.visit_reach)
+        self.mode = "explore"
+        self._side = 1.0  # +1: the tour keeps the wall on the left
+        self._tour_until = -math.inf
+        self._retarget_at = -math.inf
+        self._heading = 0.0  # explore (or escape) heading in the odometry frame
+        self._escape_until = -math.inf
+        self._backing_until = -math.inf
+        self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
+
+    def decide(
+        self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
+    ) -> tuple[float, float, float]:
+        """The command (vx, vy, wz) for this scan; ``pose`` is odometry (dead reckoning if None)."""
+        pose = self._advance(time) if pose is None else tuple(float(v) for v in pose)
+        if self._pose is not None:
+            turn = float(wrap(pose[2] - self._pose[2]))
+            self._odometry += (math.hypot(pose[0] - self._pose[0], pose[1] - self._pose[1]), turn)
+        self._pose, self._time = pose, time
+        points, allowance = self._observe(reading, pose)
+        self.visits.stamp(pose[0], pose[1], time)
+        if self._stuck(time, pose):  # back off the way it came, then head somewhere else
+            self._escape(time, self._pick_heading(points, pose))
+            self._backing_until = time + 2 * BACKING_S
+        heading = None
+        if time >= self._escape_until:
+            self._choose_mode(time, points, pose)
+            if self.mode == "tour":
+                heading = self._tour_heading(points)
+                if heading is None:  # a dead end: turn round, away from the wall
+                    self._escape(time, wrap(pose[2] - self._side * (math.pi - 0.3)))
+        if heading is None:
+            heading = self._explore_heading(points, pose)
+        self.command = self._plan(points, allowance, heading, time)
+        return self.command
+
+    def _advance(self, time: float) -> tuple[float, float, float]:
+        """Dead reckoning from the last command when no odometry is given."""
+        if self._pose is None:
+            return (0.0, 0.0, 0.0)
+        step = arc_poses(np.array([self.command]), np.array([max(0.0, time - self._time)]))[0, 0]
+        x, y = _compose(self._pose, step[None, :2])[0]
+        return (float(x), float(y), float(wrap(self._pose[2] + step[2])))
+
+    def _observe(self, reading: LaserReading, pose: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
+        """Obstacle points in the robot frame (this scan, then remembered ones out of view) and their allowances."""
+        seen = reading.points()
+        remembered = _compose(pose, self._memory[:, :2], inverse=True)
+        keep = reading.outside_view(remembered)
+        points = np.concatenate([seen, remembered[keep]])
+        stamps = np.concatenate([np.tile(self._odometry, (len(seen), 1)), self._memory[keep, 2:]])
+        distance = np.hypot(points[:, 0], points[:, 1])
+        drift = np.abs(self._odometry - stamps) * ODOM_DRIFT
+        allowance = drift[:, 0] + drift[:, 1] * distance
+        trusted = allowance <= MAX_ALLOWANCE
+        points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
+        near = distance < self.config.memory_radius
+        world = _compose(pose, points[near])
+        _, unique = np.unique(np.floor(world / MEMORY_CELL).astype(np.int64), axis=0, return_index=True)
+        unique.sort()  # the first of a cell is the freshest
+        self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
+        return points, allowance
+
+    def _stuck(self, time: float, pose: tuple[float, float, float]) -> bool:
+        """True when the robot has not got 0.5 m away from where it was STUCK_WINDOW_S ago."""
+        if not self._progress or time - self._progress[-1][0] >= 1.0:
+            self._progress.append((time, pose[0], pose[1]))
+        while len(self._progress) > 1 and time - self._progress[1][0] >= STUCK_WINDOW_S:
+            self._progress.pop(0)
+        old_time, x, y = self._progress[0]
+        if time - old_time >= STUCK_WINDOW_S and math.hypot(pose[0] - x, pose[1] - y) < 0.5:
+            self._progress = [(time, pose[0], pose[1])]
+            return True
+        return False
+
+    # -- behaviours -------------------------------------------------------------------------------
+
+    def _choose_mode(self, time: float, points: np.ndarray, pose: tuple) -> None:
+        """Explore towards new space in view (looked for every LOOK_S), else tour (side redrawn now and then)."""
+        if time < self._retarget_at and not (self.mode == "explore" and self._blocked(points, pose)):
+            return
+        self._retarget_at = time + LOOK_S
+        novelty = self._novelty(points, pose, time)
+        if novelty.max() >= NEW_SPACE:
+            current = np.argmin(np.abs(wrap(BEARINGS + pose[2] - self._heading)))
+            if self.mode != "explore" or novelty[current] < 0.5 * novelty.max():
+                weights = np.where(novelty >= NEW_SPACE, novelty, 0.0) ** 3
+                self._heading = float(wrap(pose[2] + self.rng.choice(BEARINGS, p=weights / weights.sum())))
+            self.mode = "explore"
+        elif self.mode == "explore" or time >= self._tour_until:
+            self.mode = "tour"
+            self._tour_until = time + self.rng.uniform(*self.config.tour_s)
+            self._side = float(self.rng.choice((-1.0, 1.0)))
+
+    def _novelty(self, points: np.ndarray, pose: tuple, time: float) -> np.ndarray:
+        """Metres of not recently visited space the robot could reach along each of BEARINGS."""
+        reach = self._free_distance(points, BEARINGS) + self._front + 0.5
+        x, y = SAMPLES * np.cos(BEARINGS)[:, None], SAMPLES * np.sin(BEARINGS)[:, None]
+        world = _compose(pose, np.stack([x.ravel(), y.ravel()], axis=-1)).reshape(*x.shape, 2)
+        new = ~self.visits.visited_since(world, time - self.config.visit_memory_s) & (reach[:, None] >= SAMPLES)
+        return new.sum(axis=1) * (SAMPLES[1] - SAMPLES[0])
+
+    def _escape(self, time: float, heading: float) -> None:
+        """Cruise towards ``heading`` (odometry frame) for a few seconds, whatever the episode."""
+        self._escape_until = time + ESCAPE_S
+        self._heading = heading
+
+    def _free_distance(self, points: np.ndarray, bearings: np.ndarray, half: float | None = None) -> np.ndarray:
+        """How far (m) a corridor of half-width ``half`` (default: the body's + 0.1 m) is free along each bearing."""
+        front, half_width = self._front, self._half_width
+        half = half_width + 0.1 if half is None else half
+        c, s = np.cos(bearings)[:, None], np.sin(bearings)[:, None]
+        along = c * points[:, 0] + s * points[:, 1]
+        blocking = (along > 0) & (np.abs(c * points[:, 1] - s * points[:, 0]) < half)
+        return np.where(blocking, along - front, np.inf).min(axis=1, initial=np.inf)
+
+    def _pick_heading(self, points: np.ndarray, pose: tuple) -> float:
+        """A random open direction (odometry frame), favouring deep ones; a turn-around if none is open."""
+        free = np.minimum(self._free_distance(points, BEARINGS), 6.0)
+        weights = np.where(free >= OPEN_RANGE, free**2, 0.0)
+        if weights.sum() == 0:
+            return float(wrap(pose[2] + self.rng.choice((-1, 1)) * self.rng.uniform(2.0, math.pi)))
+        return float(wrap(pose[2] + self.rng.choice(BEARINGS, p=weights / weights.sum())))
+
+    def _blocked(self, points: np.ndarray, pose: tuple) -> bool:
+        """Whether the explore heading, when in view, runs into something within BLOCKED_RANGE."""
+        relative = wrap(self._heading - pose[2])
+        return abs(relative) < BEARINGS[-1] and self._free_distance(points, np.array([relative]))[0] < BLOCKED_RANGE
+
+    def _explore_heading(self, points: np.ndarray, pose: tuple) -> float:
+        """Relative heading towards the explore (or escape) heading, redrawn at random when blocked."""
+        if self._blocked(points, pose):
+            self._heading = self._pick_heading(points, pose)
+        return float(wrap(self._heading - pose[2]))
+
+    def _tour_heading(self, points: np.ndarray) -> float | None:
+        """The open direction nearest round to the followed side (a left/right-hand rule), None in a dead end.
+
+        Open means a corridor TOUR_GAP wider than the body on each side is free for TOUR_RANGE, so the robot
+        takes every door and corner on its side; with no wall within WALL_NEAR on that side it goes straight
+        on until it meets one.
+        """
+        bearing = np.arctan2(points[:, 1], points[:, 0]) * self._side
+        if not ((bearing > 0) & (np.hypot(points[:, 0], points[:, 1]) < WALL_NEAR)).any():
+            return 0.0
+        bearings = self._side * np.radians(np.arange(100, -101, -5))
+        open_ = np.flatnonzero(self._free_distance(points, bearings, self._half_width + TOUR_GAP) >= TOUR_RANGE)
+        return float(bearings[open_[0]]) if len(open_) else None
+
+    # -- the safety-checked choice -----------------------------------------------------------------
+
+    def _plan(self, points: np.ndarray, allowance: np.ndarray, heading: float, time: float) -> tuple[float, ...]:
+        """The best command for ``heading`` among those whose arc keeps the body clear of every point."""
+        config = self.config
+        distance = np.hypot(points[:, 0], points[:, 1])
+        near = distance < self._groups[-1][0]
+        _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
+        order = thin[np.argsort(distance[near][thin])]
+        points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
+        now = self._body_distance(points[:, 0], points[:, 1])
+        keep_off = config.safety_distance + allowance
+        limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+        closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
+        for reach, rows in self._groups:  # a slow arc only needs the points it can reach
+            count = int(np.searchsorted(distance, reach))
+            if count:
+                x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
+                c, s = np.cos(yaw), np.sin(yaw)
+                dx, dy = points[:count, 0] - x, points[:count, 1] - y
+                margin = self._body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:count]
+                closest[rows] = margin.min(axis=2)
+        hit = np.logical_or.accumulate(closest < 0, axis=1)
+        safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+        clearance = np.where(hit, np.inf, closest).min(axis=1)
+        look_x, look_y, look_yaw = self._look.T
+        progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
+        speed = self.commands[:, 0]
+        backing = time < self._backing_until
+        score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
+                 + np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
+                 - 0.2 * np.abs(self.commands[:, 2] - self.command[2]) / config.turn_rate
+                 - 8.0 * self._cramped(points)
+                 - np.where(backing, speed > 0, speed < 0))  # reverse only to get out, then only until free
+        admissible = safe_until >= ADMISSIBLE_S
+        if not admissible.any():  # nothing stays clear long enough: whatever stays clear longest, then
+            admissible = safe_until == safe_until.max()  # with least intrusion in its first step
+            score = closest[:, 0]
+        best = int(np.argmax(np.where(admissible, score, -np.inf)))
+        if speed[best] < 0 and not backing:
+            self._backing_until = time + BACKING_S
+        return tuple(float(v) for v in self.commands[best])
+
+    def _cramped(self, points: np.ndarray) -> np.ndarray:
+        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
+        x, y = (self._poses[:, TURN_CHECK, k, None] for k in range(2))
+        nearest = np.hypot(points[:, 0] - x, points[:, 1] - y).min(axis=1, initial=np.inf)
+        return np.maximum(self._radius + self.config.safety_distance - nearest, 0.0)
+
+    def _body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Distance from body-frame points to the body (0 inside): the nearest of its rectangles."""
+        distance = None
+        for x_min, x_max, y_min, y_max in self._boxes:
+            dx = np.maximum(np.maximum(x - x_max, x_min - x), 0.0)
+            dy = np.maximum(np.maximum(y - y_max, y_min - y), 0.0)
+            box = np.hypot(dx, dy)
+            distance = box if distance is None else np.minimum(distance, box)
+        return distance

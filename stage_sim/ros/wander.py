@@ -1,0 +1,134 @@
+"""``wander [--ros-args ...]``: a reactive wanderer that never stops, never collides and explores the map.
+
+Subscribes ``base_scan`` and ``odom`` (relative, so a namespace selects the robot) and publishes one
+``geometry_msgs/Twist`` on ``cmd_vel`` per scan, decided by :class:`stage_sim.core.reactive.Wanderer`
+(see there for the strategy). Each scan is paired with the odometry of the same stamp, so the remembered
+obstacle points behind the robot stay where they were; the laser's mounting comes from ``/tf_static``
+(parameter ``laser_pose`` until it has arrived). Parameters: ``forward_speed`` (m/s), ``safety_distance`` (m),
+``turn_rate`` (rad/s), ``holonomic`` (omni drive), ``seed`` (-1: random), ``footprint`` (the body as
+rectangles, flattened ``[x_min, x_max, y_min, y_max, ...]``), ``laser_pose`` ``[x, y, yaw]``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from collections import deque
+from typing import Any
+
+# Project rule: discovery stays on loopback unless the user chose otherwise (set before rclpy loads).
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import numpy as np
+import rclpy
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
+
+from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+
+RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+ODOM_KEPT = 50  # recent odometry messages kept for pairing with scans by stamp
+
+
+def _nanoseconds(stamp: Any) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+def _yaw(q: Any) -> float:
+    """Yaw of a quaternion (the rotation about z; roll and pitch are zero here)."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+class Wander(Node):
+    """Drives one robot with a :class:`Wanderer`; ``kwargs`` go to :class:`rclpy.node.Node`."""
+
+    def __init__(self, node_name: str = "wander", **kwargs: Any) -> None:
+        super().__init__(node_name, **kwargs)
+        defaults = WanderConfig()
+        seed = int(self.declare_parameter("seed", -1).value)
+        config = WanderConfig(
+            forward_speed=float(self.declare_parameter("forward_speed", defaults.forward_speed).value),
+            safety_distance=float(self.declare_parameter("safety_distance", defaults.safety_distance).value),
+            turn_rate=float(self.declare_parameter("turn_rate", defaults.turn_rate).value),
+            holonomic=bool(self.declare_parameter("holonomic", defaults.holonomic).value),
+            footprint=tuple(np.reshape(self.declare_parameter(
+                "footprint", [float(v) for box in defaults.footprint for v in box]).value, (-1, 4)).tolist()),
+        )
+        self.default_laser_pose = tuple(self.declare_parameter("laser_pose", [0.23, 0.0, 0.0]).value)
+        self.wanderer = Wanderer(config, seed=None if seed < 0 else seed)
+        self.laser_poses: dict[str, tuple[float, float, float]] = {}  # frame -> pose on the robot, from /tf_static
+        self._odometry: deque[tuple[int, tuple[float, float, float]]] = deque(maxlen=ODOM_KEPT)
+        self._pending: LaserScan | None = None  # a scan waiting for the odometry of its stamp
+        self.publisher = self.create_publisher(Twist, "cmd_vel", RELIABLE_10)
+        self.create_subscription(LaserScan, "base_scan", self.on_scan, RELIABLE_10)
+        self.create_subscription(Odometry, "odom", self.on_odom, RELIABLE_10)
+        self.create_subscription(TFMessage, "/tf_static", self.on_tf_static, LATCHED)
+
+    def on_tf_static(self, msg: TFMessage) -> None:
+        """Remember where every statically mounted frame sits (the scan's frame among them)."""
+        for transform in msg.transforms:
+            t = transform.transform
+            self.laser_poses[transform.child_frame_id] = (t.translation.x, t.translation.y, _yaw(t.rotation))
+
+    def on_odom(self, msg: Odometry) -> None:
+        p = msg.pose.pose
+        self._odometry.append((_nanoseconds(msg.header.stamp), (p.position.x, p.position.y, _yaw(p.orientation))))
+        if self._pending is not None and _nanoseconds(self._pending.header.stamp) == self._odometry[-1][0]:
+            scan, self._pending = self._pending, None
+            self.decide(scan, self._odometry[-1][1])
+
+    def on_scan(self, msg: LaserScan) -> None:
+        """Answer at once when the odometry of the scan's stamp is in, else when it comes."""
+        stamp = _nanoseconds(msg.header.stamp)
+        pose = next((pose for t, pose in reversed(self._odometry) if t == stamp), None)
+        if pose is not None or not self._odometry:  # no odometry at all: the wanderer dead-reckons
+            self.decide(msg, pose)
+        else:
+            if self._pending is not None:  # its odometry never came: use the latest rather than skip it
+                self.decide(self._pending, self._odometry[-1][1])
+            self._pending = msg
+
+    def decide(self, scan: LaserScan, pose: tuple[float, float, float] | None) -> None:
+        """Publish the wanderer's command for one scan."""
+        reading = LaserReading(
+            np.asarray(scan.ranges, dtype=np.float64), scan.angle_min, scan.angle_increment, scan.range_min,
+            scan.range_max, self.laser_poses.get(scan.header.frame_id, self.default_laser_pose))
+        vx, vy, wz = self.wanderer.decide(reading, _nanoseconds(scan.header.stamp) / 1e9, pose)
+        msg = Twist()
+        msg.linear.x, msg.linear.y, msg.angular.z = vx, vy, wz
+        self.publisher.publish(msg)
+
+    def stop(self) -> None:
+        """Publish a zero twist (on the way out: the robot must not keep the last command)."""
+        if self.context.ok():
+            self.publisher.publish(Twist())
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the wanderer until Ctrl-C or shutdown; returns the exit status."""
+    rclpy.init(args=sys.argv if argv is None else argv)
+    node = None
+    try:
+        node = Wander()
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+        return 0
+    except (KeyboardInterrupt, ExternalShutdownException):
+        return 0
+    finally:
+        if node is not None:
+            node.stop()
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
