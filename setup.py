@@ -29,6 +29,7 @@ setup(
             "stage_sim = stage_sim.cli:main",
             "stageros = stage_sim.ros.stageros_main:main",
             "teleop = stage_sim.ros.teleop:main",
+            "wander = stage_sim.ros.wander:main",
         ],
     },
 )

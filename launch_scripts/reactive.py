@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Simulator + wanderer (the course's ``reactive.launch``), in one process, without the launch package.
 
-``python launch_scripts/reactive.py [WORLD] [--speedup X] [--duration S] [--seed N]`` runs the world
+``python launch_scripts/reactive.py [WORLD] [--speedup X] [--duration S] [--seed N] [--record OUT]`` runs the world
 (default ``rooms.world``) with a ``wander`` node per robot until ``--duration`` sim seconds or Ctrl-C, then
 prints one JSON summary per robot: sim_seconds, distance_m, stall_events, longest_stop_s, coverage.
 ``--speedup 0`` runs in lockstep as fast as possible, reproducibly for a given ``--seed``.

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Simulator + keyboard teleop (the course's ``teleop.launch``), in one process, without the launch package.
 
-``python launch_scripts/teleop.py [WORLD] [--speedup X] [--duration S] [--seed N]`` runs the world (default
-``rooms.world``) and drives its first robot with teleop_twist_keyboard's keys typed on this terminal
-(``u i o / j k l / m , .``; Ctrl-C quits) until Ctrl-C or ``--duration`` sim seconds.
+``python launch_scripts/teleop.py [WORLD] [--speedup X] [--duration S] [--seed N] [--record OUT]`` runs the
+world (default ``rooms.world``) and drives its first robot with teleop_twist_keyboard's keys typed on this
+terminal (``u i o / j k l / m , .``; Ctrl-C quits) until Ctrl-C or ``--duration`` sim seconds.
 """
 
 import os
@@ -19,6 +19,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
 from stage_sim.core.errors import WorldError
+from stage_sim.ros.recording import recording
 from stage_sim.ros.session import parse_args, sigterm_interrupts
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.teleop import KeyReader, TeleopTwistKeyboard
@@ -49,11 +50,14 @@ def main(argv: list[str]) -> int:
             for node in nodes:
                 executor.add_node(node)
             spinner = threading.Thread(target=spin, name="stage-spin", daemon=True)
-            spinner.start()
-            with KeyReader(sys.stdin) as keys:
-                teleop.run(keys)
-            done.set()
-            spinner.join()
+            with recording(stage, args, "teleop.py"):
+                spinner.start()
+                try:
+                    with KeyReader(sys.stdin) as keys:
+                        teleop.run(keys)
+                finally:  # the world stops stepping before the recording is written
+                    done.set()
+                    spinner.join()
         return 0
     except (WorldError, FileNotFoundError, ValueError) as error:
         print(f"teleop.py: {error}", file=sys.stderr)

@@ -240,26 +240,9 @@ def _straight(sim: Simulation, seed: int | None) -> Callable[[], None]:
 
 def _wander(sim: Simulation, seed: int | None) -> Callable[[], None]:
     """The ``wander`` node's reactive strategy on every robot's first laser (robots without one stay put)."""
-    from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+    from stage_sim.core.wander_driver import WanderDriver
 
-    drivers = [
-        (robot, Wanderer(WanderConfig(holonomic=robot.settings.drive == "omni"),
-                         None if seed is None else seed + robot.index))
-        for robot in sim.robots if robot.rangers
-    ]
-
-    def decide() -> None:
-        for robot, wanderer in drivers:
-            ranger = robot.rangers[0]
-            sensor = ranger.sensor
-            reading = LaserReading(
-                sim.scans[robot.index][0].ranges, -sensor.fov / 2, sensor.fov / max(sensor.samples - 1, 1),
-                sensor.range_min, sensor.range_max, (*ranger.ray_offset, ranger.ray_yaw),
-            )
-            pose = tuple(float(v) for v in sim.odometry_poses[robot.index])
-            sim.set_velocity(robot.index, *wanderer.decide(reading, sim.sim_time, pose))
-
-    return decide
+    return WanderDriver(sim, seed).decide
 
 
 _CONTROLLERS: dict[str, Callable[[Simulation, int | None], Callable[[], None]]] = {

@@ -20,6 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
+from stage_sim.core.visit_map import VisitMap
+
 # Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
 CHECK_TIMES = np.array([0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.1, 1.5])
 SAFE_TIMES = np.concatenate([[0.0], CHECK_TIMES[:-1]])  # how long an arc stays clear if it hits at index k
@@ -29,8 +32,10 @@ LOOK_AHEAD_S = 1.0  # heading and progress of a candidate are judged at this tim
 TOLERANCE = 0.005  # m a point already inside the safety distance may come closer (sensor quantisation)
 MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
 CLEARANCE_CAP = 0.15  # m of clearance beyond which more is no better
+CLEARANCE_WEIGHT = 2.5  # worth of that clearance against heading and progress (about 1 each)
 PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
 ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net turn (m/m, rad/rad) since a point was seen
+MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free space for a point to be moving
 MAX_ALLOWANCE = 0.1  # m: remembered points less certain than this are forgotten
 OPEN_RANGE = 1.5  # m of free corridor ahead for an escape direction to count as open
 BLOCKED_RANGE = 0.7  # m of free corridor below which an explore heading is abandoned
@@ -40,10 +45,13 @@ WALL_NEAR = 1.2  # m: a tour with no wall this near on its side goes straight on
 BEARINGS = np.radians(np.arange(-110, 111, 5))  # directions weighed for exploring and escaping
 SAMPLES = np.arange(0.5, 5.01, 0.5)  # m along a direction where unvisited space is looked for
 NEW_SPACE = 2.0  # m of unvisited space in a direction that makes it worth exploring
+NEARNESS = 3.0  # m over which the weight of unvisited space falls by e when choosing where to explore
 LOOK_S = 0.5  # s between looks for new space
+GIVE_UP_RADIUS = 2.0  # m around a stuck spot whose new space is given up on
 STUCK_WINDOW_S = 12.0  # no 0.5 m of progress within this long → escape along a new heading
 ESCAPE_S = 4.0  # s spent heading away from a dead end or a stuck spot
 BACKING_S = 1.0  # s a reverse manoeuvre is kept up before driving forward again
+REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 
 
 @dataclass(frozen=True)
@@ -57,6 +65,7 @@ class WanderConfig:
     # The body as rectangles (x_min, x_max, y_min, y_max) in the robot frame: chassis and laser housing.
     footprint: tuple[tuple[float, float, float, float], ...] = ((-0.2, 0.2, -0.15, 0.15), (0.2, 0.26, -0.03, 0.03))
     memory_radius: float = 1.5  # m around the robot within which out-of-view points are remembered
+    moving_speed: float = 0.7  # m/s assumed for things seen moving in (other robots) when keeping clear of them
     tour_s: tuple[float, float] = (40.0, 120.0)  # duration range of a tour before its side is redrawn
     visit_reach: float = 1.0  # m around the path that counts as visited
     visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
@@ -73,10 +82,14 @@ class LaserReading:
     range_max: float
     laser_pose: tuple[float, float, float] = (0.23, 0.0, 0.0)
 
-    def points(self) -> np.ndarray:
-        """Hit points (P, 2) in the robot frame; misses (range_max, inf, NaN) are dropped."""
+    def hits(self) -> np.ndarray:
+        """Which beams hit something (misses report range_max, inf or NaN)."""
         ranges = np.asarray(self.ranges, dtype=np.float64)
-        hit = np.isfinite(ranges) & (ranges >= self.range_min) & (ranges < self.range_max)
+        return np.isfinite(ranges) & (ranges >= self.range_min) & (ranges < self.range_max)
+
+    def points(self) -> np.ndarray:
+        """Hit points (P, 2) in the robot frame, in beam order."""
+        ranges, hit = np.asarray(self.ranges, dtype=np.float64), self.hits()
         x, y, yaw = self.laser_pose
         angles = yaw + self.angle_min + np.flatnonzero(hit) * self.angle_increment
         return np.stack([x + ranges[hit] * np.cos(angles), y + ranges[hit] * np.sin(angles)], axis=-1)
@@ -103,63 +116,6 @@ def _compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool
     return np.stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]], -1)
 
 
-def arc_poses(commands: np.ndarray, times: np.ndarray) -> np.ndarray:
-    """Exact poses (C, T, 3) reached from the origin holding each body twist (vx, vy, wz) for ``times``."""
-    vx, vy, w = (commands[:, k, None] for k in range(3))
-    yaw = w * times
-    small = np.abs(w) < 1e-9
-    safe_w = np.where(small, 1.0, w)
-    sin_term = np.where(small, times, np.sin(yaw) / safe_w)
-    cos_term = np.where(small, 0.0, (1 - np.cos(yaw)) / safe_w)
-    return np.stack([vx * sin_term - vy * cos_term, vx * cos_term + vy * sin_term, yaw], axis=-1)
-
-
-def candidate_commands(config: WanderConfig) -> np.ndarray:
-    """The fixed command set (C, 3): forward arcs, turns in place, a slow reverse; never all zero."""
-    turns = np.linspace(-config.turn_rate, config.turn_rate, 13)
-    speeds = [-0.15, *np.linspace(0.0, config.forward_speed, 7)]
-    commands = [(v, 0.0, w) for v in speeds for w in turns]
-    if config.holonomic:
-        side = min(0.3, config.forward_speed)
-        commands += [(v, vy, w) for v in (0.0, side) for vy in (-side, side) for w in (-0.4, 0.0, 0.4)]
-    array = np.array(commands)
-    return array[np.any(array != 0.0, axis=1)]
-
-
-class VisitMap:
-    """When each cell of a coarse grid (odometry frame, growing as needed) last came within reach of the robot."""
-
-    def __init__(self, cell: float = 0.5, reach: float = 1.0) -> None:
-        self.cell = cell
-        r = math.ceil(reach / cell)
-        di, dj = np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1), indexing="ij")
-        inside = np.hypot(di, dj) * cell <= reach
-        self._disc = (di[inside], dj[inside])
-        self._low = np.zeros(2, dtype=np.int64)
-        self.times = np.full((0, 0), -np.inf)
-
-    def stamp(self, x: float, y: float, time: float) -> None:
-        """Mark the cells within reach of (x, y) as visited at ``time``."""
-        i, j = math.floor(x / self.cell), math.floor(y / self.cell)
-        r = int(self._disc[0].max())
-        low, high = self._low, self._low + self.times.shape
-        if i - r < low[0] or j - r < low[1] or i + r >= high[0] or j + r >= high[1]:
-            new_low = np.minimum(low, (i - r - 20, j - r - 20))
-            new_high = np.maximum(high, (i + r + 21, j + r + 21))
-            grown = np.full(new_high - new_low, -np.inf)
-            offset = low - new_low
-            grown[offset[0]: offset[0] + self.times.shape[0], offset[1]: offset[1] + self.times.shape[1]] = self.times
-            self.times, self._low = grown, new_low
-        self.times[self._disc[0] + i - self._low[0], self._disc[1] + j - self._low[1]] = time
-
-    def visited_since(self, xy: np.ndarray, since: float) -> np.ndarray:
-        """Whether each point (..., 2) lies in a cell visited at or after ``since``."""
-        index = np.floor(xy / self.cell).astype(np.int64) - self._low
-        inside = np.all((index >= 0) & (index < self.times.shape), axis=-1)
-        clipped = np.clip(index, 0, np.maximum(np.array(self.times.shape) - 1, 0))
-        return inside & (self.times[clipped[..., 0], clipped[..., 1]] >= since) if self.times.size else inside
-
-
 class Wanderer:
     """Decides a velocity command per scan; the same seed and inputs give the same commands."""
 
@@ -180,18 +136,24 @@ class Wanderer:
         self._groups = [(v * CHECK_TIMES[-1] + self._radius + margin, np.flatnonzero(speeds == v))
                         for v in np.unique(speeds)]
         self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
+        self._last_scan: tuple | None = None  # the previous scan: laser pose (odometry frame) and ranges
         self._odometry = np.zeros(2)  # metres driven and net radians turned so far (odometry errors scale with these)
         self._pose: tuple[float, float, float] | None = None
         self._time = 0.0
         self.command = (0.0, 0.0, 0.0)
         self.visits = VisitMap(reach=self.config.visit_reach)
+        offsets = np.arange(-GIVE_UP_RADIUS, GIVE_UP_RADIUS + 0.01, self.visits.cell)
+        disc = np.stack(np.meshgrid(offsets, offsets), axis=-1).reshape(-1, 2)
+        self._give_up_disc = disc[np.hypot(disc[:, 0], disc[:, 1]) <= GIVE_UP_RADIUS]
         self.mode = "explore"
         self._side = 1.0  # +1: the tour keeps the wall on the left
         self._tour_until = -math.inf
+        self._tour_turn = 0.0  # net heading change of the current tour
         self._retarget_at = -math.inf
         self._heading = 0.0  # explore (or escape) heading in the odometry frame
         self._escape_until = -math.inf
         self._backing_until = -math.inf
+        self._reverse_room = 0.0  # m the robot may back up: along the path it came, never into unseen space
         self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
 
     def decide(
@@ -202,10 +164,15 @@ class Wanderer:
         if self._pose is not None:
             turn = float(wrap(pose[2] - self._pose[2]))
             self._odometry += (math.hypot(pose[0] - self._pose[0], pose[1] - self._pose[1]), turn)
+            forward = math.cos(self._pose[2]) * (pose[0] - self._pose[0]) + math.sin(self._pose[2]) * (
+                pose[1] - self._pose[1])
+            self._reverse_room = min(max(self._reverse_room + forward, 0.0), REVERSE_ROOM_MAX)
+            self._tour_turn += turn
         self._pose, self._time = pose, time
-        points, allowance = self._observe(reading, pose)
+        points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
-        if self._stuck(time, pose):  # back off the way it came, then head somewhere else
+        if self._stuck(time, pose):  # give up on new space around here, back off, then head somewhere else
+            self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
             self._escape(time, self._pick_heading(points, pose))
             self._backing_until = time + 2 * BACKING_S
         heading = None
@@ -217,7 +184,7 @@ class Wanderer:
                     self._escape(time, wrap(pose[2] - self._side * (math.pi - 0.3)))
         if heading is None:
             heading = self._explore_heading(points, pose)
-        self.command = self._plan(points, allowance, heading, time)
+        self.command = self._plan(points, allowance, moving, heading, time)
         return self.command
 
     def _advance(self, time: float) -> tuple[float, float, float]:
@@ -228,9 +195,11 @@ class Wanderer:
         x, y = _compose(self._pose, step[None, :2])[0]
         return (float(x), float(y), float(wrap(self._pose[2] + step[2])))
 
-    def _observe(self, reading: LaserReading, pose: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
-        """Obstacle points in the robot frame (this scan, then remembered ones out of view) and their allowances."""
-        seen = reading.points()
+    def _observe(self, reading: LaserReading, pose: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Obstacle points in the robot frame (this scan, then remembered ones out of view), their allowances,
+        and which of them are moving (nearer than the last scan put anything along their beam)."""
+        seen, beams = reading.points(), reading.hits()
+        moving = self._approaching(reading, pose)[beams]
         remembered = _compose(pose, self._memory[:, :2], inverse=True)
         keep = reading.outside_view(remembered)
         points = np.concatenate([seen, remembered[keep]])
@@ -239,13 +208,39 @@ class Wanderer:
         drift = np.abs(self._odometry - stamps) * ODOM_DRIFT
         allowance = drift[:, 0] + drift[:, 1] * distance
         trusted = allowance <= MAX_ALLOWANCE
+        moving = np.concatenate([moving, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
         points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
         near = distance < self.config.memory_radius
         world = _compose(pose, points[near])
         _, unique = np.unique(np.floor(world / MEMORY_CELL).astype(np.int64), axis=0, return_index=True)
         unique.sort()  # the first of a cell is the freshest
         self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
-        return points, allowance
+        return points, allowance, moving
+
+    def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
+        """Per beam: whether it hits something where the previous scan saw free space (its beam, or a
+        neighbour, reached further), i.e. something that moved in, such as another robot."""
+        ranges = np.asarray(reading.ranges, dtype=np.float64)
+        x, y, yaw = reading.laser_pose
+        here = (pose[0] + math.cos(pose[2]) * x - math.sin(pose[2]) * y,
+                pose[1] + math.sin(pose[2]) * x + math.cos(pose[2]) * y, pose[2] + yaw)
+        previous, self._last_scan = self._last_scan, (here, np.where(reading.hits(), ranges, reading.range_max))
+        if previous is None:
+            return np.zeros(len(ranges), dtype=bool)
+        (px, py, pyaw), before = previous
+        angles = here[2] + reading.angle_min + np.arange(len(ranges)) * reading.angle_increment
+        end = np.stack([here[0] + ranges * np.cos(angles), here[1] + ranges * np.sin(angles)], axis=-1)
+        seen_from = _compose((px, py, pyaw), end, inverse=True)  # the hit points in the previous laser frame
+        distance = np.hypot(seen_from[:, 0], seen_from[:, 1])
+        index = np.rint((np.arctan2(seen_from[:, 1], seen_from[:, 0]) - reading.angle_min)
+                        / reading.angle_increment).astype(np.int64)
+        padded = np.concatenate([[np.inf], before, [np.inf]])
+        inside = (index >= 0) & (index < len(before))
+        index = np.clip(index, 0, len(before) - 1) + 1
+        free_to = np.minimum(np.minimum(padded[index - 1], padded[index]), padded[index + 1])
+        nearer = inside & reading.hits() & (distance < free_to - (MOVED + MOVED_PER_M * distance))
+        nearer = np.concatenate([[False], nearer, [False]])
+        return nearer[1:-1] & (nearer[:-2] | nearer[2:])  # a lone beam is an edge effect, not a body
 
     def _stuck(self, time: float, pose: tuple[float, float, float]) -> bool:
         """True when the robot has not got 0.5 m away from where it was STUCK_WINDOW_S ago."""
@@ -263,28 +258,36 @@ class Wanderer:
 
     def _choose_mode(self, time: float, points: np.ndarray, pose: tuple) -> None:
         """Explore towards new space in view (looked for every LOOK_S), else tour (side redrawn now and then)."""
-        if time < self._retarget_at and not (self.mode == "explore" and self._blocked(points, pose)):
+        blocked = self.mode == "explore" and self._blocked(points, pose)
+        if time < self._retarget_at and not blocked:
             return
+        if blocked:  # what lay ahead cannot be reached from here: do not come back for it at once
+            ahead = SAMPLES[BLOCKED_RANGE + self._front + 0.5 >= SAMPLES]
+            self.visits.mark(np.stack([pose[0] + ahead * math.cos(self._heading),
+                                       pose[1] + ahead * math.sin(self._heading)], axis=-1), time)
         self._retarget_at = time + LOOK_S
-        novelty = self._novelty(points, pose, time)
+        novelty, value = self._novelty(points, pose, time)
         if novelty.max() >= NEW_SPACE:
+            value = np.where(novelty >= NEW_SPACE, value, 0.0)
             current = np.argmin(np.abs(wrap(BEARINGS + pose[2] - self._heading)))
-            if self.mode != "explore" or novelty[current] < 0.5 * novelty.max():
-                weights = np.where(novelty >= NEW_SPACE, novelty, 0.0) ** 3
+            if self.mode != "explore" or value[current] < 0.5 * value.max():
+                weights = value**3
                 self._heading = float(wrap(pose[2] + self.rng.choice(BEARINGS, p=weights / weights.sum())))
             self.mode = "explore"
-        elif self.mode == "explore" or time >= self._tour_until:
-            self.mode = "tour"
+        elif self.mode == "explore" or time >= self._tour_until or self._side * self._tour_turn >= 2 * math.pi:
+            self.mode, self._tour_turn = "tour", 0.0  # a full turn towards the wall: circling an island
             self._tour_until = time + self.rng.uniform(*self.config.tour_s)
             self._side = float(self.rng.choice((-1.0, 1.0)))
 
-    def _novelty(self, points: np.ndarray, pose: tuple, time: float) -> np.ndarray:
-        """Metres of not recently visited space the robot could reach along each of BEARINGS."""
+    def _novelty(self, points: np.ndarray, pose: tuple, time: float) -> tuple[np.ndarray, np.ndarray]:
+        """Metres of not recently visited space the robot could reach along each of BEARINGS, and the same
+        with nearer space weighing more (so that the robot takes the door it passes before far corridors)."""
         reach = self._free_distance(points, BEARINGS) + self._front + 0.5
         x, y = SAMPLES * np.cos(BEARINGS)[:, None], SAMPLES * np.sin(BEARINGS)[:, None]
         world = _compose(pose, np.stack([x.ravel(), y.ravel()], axis=-1)).reshape(*x.shape, 2)
         new = ~self.visits.visited_since(world, time - self.config.visit_memory_s) & (reach[:, None] >= SAMPLES)
-        return new.sum(axis=1) * (SAMPLES[1] - SAMPLES[0])
+        step = SAMPLES[1] - SAMPLES[0]
+        return new.sum(axis=1) * step, (new * np.exp((SAMPLES[0] - SAMPLES) / NEARNESS)).sum(axis=1) * step
 
     def _escape(self, time: float, heading: float) -> None:
         """Cruise towards ``heading`` (odometry frame) for a few seconds, whatever the episode."""
@@ -335,16 +338,23 @@ class Wanderer:
 
     # -- the safety-checked choice -----------------------------------------------------------------
 
-    def _plan(self, points: np.ndarray, allowance: np.ndarray, heading: float, time: float) -> tuple[float, ...]:
-        """The best command for ``heading`` among those whose arc keeps the body clear of every point."""
+    def _plan(
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, time: float
+    ) -> tuple[float, ...]:
+        """The best command for ``heading`` among those whose arc keeps the body clear of every point, moving
+        points (other robots) being given room that grows at ``moving_speed`` along the arc."""
         config = self.config
-        distance = np.hypot(points[:, 0], points[:, 1])
+        # How near each point could come within the horizon: moving ones come nearer.
+        distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
         near = distance < self._groups[-1][0]
         _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
         order = thin[np.argsort(distance[near][thin])]
         points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
+        moving = moving[near][order]
         now = self._body_distance(points[:, 0], points[:, 1])
-        keep_off = config.safety_distance + allowance
+        backing = time < self._backing_until  # getting out of a tight spot: half the margin will do
+        keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
+                    + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
         limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
         closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
@@ -353,7 +363,7 @@ class Wanderer:
                 x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
                 c, s = np.cos(yaw), np.sin(yaw)
                 dx, dy = points[:count, 0] - x, points[:count, 1] - y
-                margin = self._body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:count]
+                margin = self._body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:, :count]
                 closest[rows] = margin.min(axis=2)
         hit = np.logical_or.accumulate(closest < 0, axis=1)
         safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
@@ -361,15 +371,17 @@ class Wanderer:
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
         speed = self.commands[:, 0]
-        backing = time < self._backing_until
         score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
-                 + np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
+                 + CLEARANCE_WEIGHT * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - self.command[2]) / config.turn_rate
                  - 8.0 * self._cramped(points)
                  - np.where(backing, speed > 0, speed < 0))  # reverse only to get out, then only until free
-        admissible = safe_until >= ADMISSIBLE_S
-        if not admissible.any():  # nothing stays clear long enough: whatever stays clear longest, then
-            admissible = safe_until == safe_until.max()  # with least intrusion in its first step
+        # Backing up is only safe over ground just driven forward: the laser does not see behind.
+        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= self._reverse_room)
+        admissible = (safe_until >= ADMISSIBLE_S) & reversible
+        if not admissible.any():  # nothing stays clear long enough: of what may be done, whatever stays clear
+            longest = np.where(reversible, safe_until, -1.0)  # longest, then with least intrusion in its first step
+            admissible = longest == longest.max()
             score = closest[:, 0]
         best = int(np.argmax(np.where(admissible, score, -np.inf)))
         if speed[best] < 0 and not backing:

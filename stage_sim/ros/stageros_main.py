@@ -19,6 +19,7 @@ from rclpy.utilities import remove_ros_args
 
 from stage_sim.core.bundled import bundled_worlds
 from stage_sim.core.errors import WorldError
+from stage_sim.ros.recording import add_record_arguments, recording
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -32,11 +33,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--speedup", type=float, default=None,
                         help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
     parser.add_argument("--seed", type=int, default=None, help="seed for drawn odometry errors and sensor noise")
-    parser.add_argument("--record", default=None, metavar="OUT",
-                        help="record the run to OUT.gif (every frame) or OUT.png (the last frame) at exit")
-    parser.add_argument("--record-every", type=float, default=0.5, metavar="S", help="sim seconds between frames")
-    parser.add_argument("--record-fps", type=float, default=None, metavar="F",
-                        help="GIF playback frames per second (default: real time)")
+    add_record_arguments(parser)
     parser.add_argument("world", nargs="?", default=None,
                         help="a .world file, or a bundled world's name (else the 'world_file' parameter)")
     return parser.parse_args(argv)
@@ -49,18 +46,14 @@ def main(argv: list[str] | None = None) -> int:
     from stage_sim.ros.stageros import StageRos
 
     rclpy.init(args=argv)
-    node = recorder = None
+    node = None
     try:
         node = StageRos(args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None)
-        if args.record:
-            from stage_sim.rendering.recorder import Recorder
-
-            recorder = Recorder(node.sim, args.record, every_s=args.record_every, fps=args.record_fps)
-            node.add_step_listener(recorder.capture_if_due)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        while rclpy.ok() and not node.finished:
-            executor.spin_once(timeout_sec=0.1)
+        with recording(node, args, "stageros"):
+            while rclpy.ok() and not node.finished:
+                executor.spin_once(timeout_sec=0.1)
         return 0
     except (WorldError, FileNotFoundError, ValueError) as error:
         print(f"stageros: {error}", file=sys.stderr)
@@ -68,8 +61,6 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         return 0
     finally:
-        if recorder is not None:
-            print(f"stageros: recorded {recorder.frame_count} frames to {recorder.close()}", file=sys.stderr)
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

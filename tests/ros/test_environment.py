@@ -122,7 +122,7 @@ def test_colcon_build_installs_ros2_run_layout(tmp_path: Path) -> None:
     install = tmp_path / "install"
     exe_dir = install / "stage_sim" / "lib" / "stage_sim"
     scripts = sorted(p.name for p in exe_dir.iterdir())
-    for exe in ("stage_sim", "stageros", "teleop"):
+    for exe in ("stage_sim", "stageros", "teleop", "wander"):
         assert exe in scripts, scripts
         assert os.access(exe_dir / exe, os.X_OK)
     assert (install / "stage_sim" / "share" / "stage_sim" / "package.xml").is_file()
