@@ -11,12 +11,10 @@ summaries printed at exit.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
-import signal
 import sys
+import threading
 import time
-from collections.abc import Iterator
 
 import rclpy
 from rclpy.clock import Clock, ClockType
@@ -28,6 +26,7 @@ from rclpy.signals import SignalHandlerOptions
 from stage_sim.core.errors import WorldError
 from stage_sim.core.run_stats import RunStats
 from stage_sim.core.wander_driver import wanderer_seed
+from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.wander import Wander
@@ -57,13 +56,14 @@ class WanderSession:
             self.executor.add_node(node)
         self.stats = RunStats(sim)
 
-    def run(self, duration: float | None = None) -> None:
-        """Step until ``duration`` sim seconds, the world's quit_time, or Ctrl-C (KeyboardInterrupt)."""
+    def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
+        """Step until ``duration`` sim seconds, the world's quit_time, or ``stop`` is set (Ctrl-C)."""
+        stop = stop or threading.Event()
         self._connect()
         stage, sim = self.stage, self.stage.sim
         if stage.speedup > 0:
             stage.create_timer(sim.interval / stage.speedup, self._step, clock=Clock(clock_type=ClockType.STEADY_TIME))
-        while not stage.finished and (duration is None or sim.sim_time < duration - 1e-9):
+        while not stage.finished and not stop.is_set() and (duration is None or sim.sim_time < duration - 1e-9):
             if stage.speedup > 0:
                 self.executor.spin_once(timeout_sec=0.1)
             else:
@@ -105,16 +105,6 @@ class WanderSession:
             self.executor.spin_once(timeout_sec=0.01)
 
 
-@contextlib.contextmanager
-def sigterm_interrupts() -> Iterator[None]:
-    """Let SIGTERM end a session like Ctrl-C, so the summaries are still printed."""
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
 def parse_args(argv: list[str], prog: str, default_world: str, description: str) -> argparse.Namespace:
     """The launch scripts' common options."""
     parser = argparse.ArgumentParser(prog=prog, description=description)
@@ -134,10 +124,10 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     session = None
     try:
-        with sigterm_interrupts():
+        with stop_requests() as stop:
             session = WanderSession(args.world, args.speedup, args.seed)
-            with recording(session.stage, args, prog), contextlib.suppress(KeyboardInterrupt):
-                session.run(args.duration)
+            with recording(session.stage, args, prog):
+                session.run(args.duration, stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)
         return 0

@@ -12,13 +12,10 @@ import codecs
 import io
 import os
 import select
-import signal
 import sys
 import termios
 import threading
 import tty
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import IO, Any, TextIO
 
@@ -33,6 +30,8 @@ from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+
+from stage_sim.ros.interrupts import sigterm_interrupts
 
 NODE_NAME = "teleop_twist_keyboard"  # the original's name, so its parameter files apply unchanged
 QUIT_KEY = "\x03"
@@ -230,19 +229,6 @@ class TeleopTwistKeyboard(Node):
                 self.publish_velocity((0.0, 0.0, 0.0, 0.0))
 
 
-@contextmanager
-def _sigterm_interrupts() -> Iterator[None]:
-    """Let SIGTERM raise KeyboardInterrupt like SIGINT, so ``run`` can still send its zero twist.
-
-    rclpy's own handlers would shut the context down first, leaving the robot on its last command.
-    """
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the teleop on stdin until Ctrl-C; 0 on a normal quit, 2 on bad parameters."""
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
@@ -250,7 +236,7 @@ def main(argv: list[str] | None = None) -> int:
     executor = SingleThreadedExecutor()
     spinner = threading.Thread(target=executor.spin, name="teleop-spin", daemon=True)
     try:
-        with _sigterm_interrupts():
+        with sigterm_interrupts():
             try:
                 node = TeleopTwistKeyboard()
             except ValueError as error:

@@ -27,10 +27,12 @@ from nav_msgs.msg import Odometry
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
 from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+from stage_sim.ros.interrupts import stop_requests
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -112,16 +114,18 @@ class Wander(Node):
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the wanderer until Ctrl-C or shutdown; returns the exit status."""
-    rclpy.init(args=sys.argv if argv is None else argv)
+    """Run the wanderer until Ctrl-C, SIGTERM or shutdown, then stop the robot; returns the exit status."""
+    rclpy.init(args=sys.argv if argv is None else argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
-        node = Wander()
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        executor.spin()
+        with stop_requests() as stop:
+            node = Wander()
+            executor = SingleThreadedExecutor()
+            executor.add_node(node)
+            while not stop.is_set():
+                executor.spin_once(timeout_sec=0.1)
         return 0
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except ExternalShutdownException:
         return 0
     finally:
         if node is not None:
