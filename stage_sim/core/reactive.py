@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stage_sim.core.doorways import DoorPassage, Doorway, find_doorways
+from stage_sim.core.laser_reading import LaserReading, wrap
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
 from stage_sim.core.visit_map import VisitMap
 
@@ -51,6 +53,10 @@ GIVE_UP_RADIUS = 2.0  # m around a stuck spot whose new space is given up on
 STUCK_WINDOW_S = 12.0  # no 0.5 m of progress within this long → escape along a new heading
 ESCAPE_S = 4.0  # s spent heading away from a dead end or a stuck spot
 BACKING_S = 1.0  # s a reverse manoeuvre is kept up before driving forward again
+DOOR_S = 30.0  # s to get through a narrow doorway before giving it up
+DOOR_EXIT = 0.6  # m past a doorway at which its passage is over
+DOOR_BEYOND = np.array([1.0, 2.0, 3.0])  # m past a doorway where new space is looked for
+DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was visited this recently
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 
 
@@ -69,42 +75,6 @@ class WanderConfig:
     tour_s: tuple[float, float] = (40.0, 120.0)  # duration range of a tour before its side is redrawn
     visit_reach: float = 1.0  # m around the path that counts as visited
     visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
-
-
-@dataclass(frozen=True)
-class LaserReading:
-    """One scan as the sensor reports it, plus where the laser sits on the robot (x, y, yaw)."""
-
-    ranges: np.ndarray
-    angle_min: float
-    angle_increment: float
-    range_min: float
-    range_max: float
-    laser_pose: tuple[float, float, float] = (0.23, 0.0, 0.0)
-
-    def hits(self) -> np.ndarray:
-        """Which beams hit something (misses report range_max, inf or NaN)."""
-        ranges = np.asarray(self.ranges, dtype=np.float64)
-        return np.isfinite(ranges) & (ranges >= self.range_min) & (ranges < self.range_max)
-
-    def points(self) -> np.ndarray:
-        """Hit points (P, 2) in the robot frame, in beam order."""
-        ranges, hit = np.asarray(self.ranges, dtype=np.float64), self.hits()
-        x, y, yaw = self.laser_pose
-        angles = yaw + self.angle_min + np.flatnonzero(hit) * self.angle_increment
-        return np.stack([x + ranges[hit] * np.cos(angles), y + ranges[hit] * np.sin(angles)], axis=-1)
-
-    def outside_view(self, points: np.ndarray) -> np.ndarray:
-        """Which robot-frame points lie outside the laser's field of view (the blind sector)."""
-        x, y, yaw = self.laser_pose
-        half_fov = (len(self.ranges) - 1) * self.angle_increment / 2
-        off_axis = wrap(np.arctan2(points[:, 1] - y, points[:, 0] - x) - yaw - self.angle_min - half_fov)
-        return np.abs(off_axis) > half_fov + 1e-3
-
-
-def wrap(angle: float | np.ndarray) -> float | np.ndarray:
-    """Angle(s) in [-π, π)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 def _compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool = False) -> np.ndarray:
@@ -145,7 +115,10 @@ class Wanderer:
         offsets = np.arange(-GIVE_UP_RADIUS, GIVE_UP_RADIUS + 0.01, self.visits.cell)
         disc = np.stack(np.meshgrid(offsets, offsets), axis=-1).reshape(-1, 2)
         self._give_up_disc = disc[np.hypot(disc[:, 0], disc[:, 1]) <= GIVE_UP_RADIUS]
-        self.mode = "explore"
+        self.mode = "explore"  # or "tour", or "door" while passing self._door
+        self._door: DoorPassage | None = None
+        self._door_widths = (2 * (self._half_width + self.config.safety_distance) + 0.02,
+                             2 * (self._half_width + TOUR_GAP) + 0.05)  # narrower than explore and tour see
         self._side = 1.0  # +1: the tour keeps the wall on the left
         self._tour_until = -math.inf
         self._tour_turn = 0.0  # net heading change of the current tour
@@ -172,12 +145,16 @@ class Wanderer:
         points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
         if self._stuck(time, pose):  # give up on new space around here, back off, then head somewhere else
+            if self._door is not None:
+                self._leave_door(time, given_up=True)
             self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
             self._escape(time, self._pick_heading(points, pose))
             self._backing_until = time + 2 * BACKING_S
         heading = None
         if time >= self._escape_until:
-            self._choose_mode(time, points, pose)
+            self._choose_mode(time, points, pose, reading)
+            if self.mode == "door":
+                heading = self._door_heading(reading, pose, time)
             if self.mode == "tour":
                 heading = self._tour_heading(points)
                 if heading is None:  # a dead end: turn round, away from the wall
@@ -256,8 +233,11 @@ class Wanderer:
 
     # -- behaviours -------------------------------------------------------------------------------
 
-    def _choose_mode(self, time: float, points: np.ndarray, pose: tuple) -> None:
-        """Explore towards new space in view (looked for every LOOK_S), else tour (side redrawn now and then)."""
+    def _choose_mode(self, time: float, points: np.ndarray, pose: tuple, reading: LaserReading) -> None:
+        """Through a narrow doorway with new space behind it, else explore towards new space in view (both
+        looked for every LOOK_S), else tour (side redrawn now and then)."""
+        if self.mode == "door":
+            return
         blocked = self.mode == "explore" and self._blocked(points, pose)
         if time < self._retarget_at and not blocked:
             return
@@ -266,6 +246,10 @@ class Wanderer:
             self.visits.mark(np.stack([pose[0] + ahead * math.cos(self._heading),
                                        pose[1] + ahead * math.sin(self._heading)], axis=-1), time)
         self._retarget_at = time + LOOK_S
+        self._door = self._door_to_take(reading, pose, time)
+        if self._door is not None:
+            self.mode = "door"
+            return
         novelty, value = self._novelty(points, pose, time)
         if novelty.max() >= NEW_SPACE:
             value = np.where(novelty >= NEW_SPACE, value, 0.0)
@@ -278,6 +262,32 @@ class Wanderer:
             self.mode, self._tour_turn = "tour", 0.0  # a full turn towards the wall: circling an island
             self._tour_until = time + self.rng.uniform(*self.config.tour_s)
             self._side = float(self.rng.choice((-1.0, 1.0)))
+
+    def _doorways(self, reading: LaserReading) -> list[Doorway]:
+        return find_doorways(reading, *self._door_widths)
+
+    def _door_to_take(self, reading: LaserReading, pose: tuple, time: float) -> DoorPassage | None:
+        """The nearest narrow doorway in view whose far side is new (or, touring, not visited lately)."""
+        since = time - (DOOR_RECENT_S if self.mode == "tour" else self.config.visit_memory_s)
+        passages = [DoorPassage.seen_from(doorway, pose, time + DOOR_S) for doorway in self._doorways(reading)]
+        fresh = [p for p in passages if (~self.visits.visited_since(p.beyond(DOOR_BEYOND), since)).sum() >= 2]
+        return min(fresh, key=lambda p: -p.progress(pose)[0], default=None)
+
+    def _door_heading(self, reading: LaserReading, pose: tuple, time: float) -> float | None:
+        """Relative heading along the doorway's axis; None once through (or given up after DOOR_S)."""
+        door = self._door
+        door.refine(self._doorways(reading), pose)
+        along, _ = door.progress(pose)
+        if along > DOOR_EXIT or time > door.until:
+            self._leave_door(time, given_up=along <= DOOR_EXIT)
+            return None
+        return float(wrap(door.heading(pose) - pose[2]))
+
+    def _leave_door(self, time: float, given_up: bool) -> None:
+        """Back to exploring; a doorway given up on has its far side marked visited so it is not retried at once."""
+        if given_up:
+            self.visits.mark(self._door.beyond(DOOR_BEYOND), time)
+        self._door, self.mode, self._retarget_at = None, "explore", -math.inf
 
     def _novelty(self, points: np.ndarray, pose: tuple, time: float) -> tuple[np.ndarray, np.ndarray]:
         """Metres of not recently visited space the robot could reach along each of BEARINGS, and the same
@@ -371,10 +381,11 @@ class Wanderer:
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
         speed = self.commands[:, 0]
+        door = self.mode == "door"  # a narrow door leaves little clearance and no room to turn: ask for less
         score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
-                 + CLEARANCE_WEIGHT * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
+                 + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - self.command[2]) / config.turn_rate
-                 - 8.0 * self._cramped(points)
+                 - (1.0 if door else 8.0) * self._cramped(points)
                  - np.where(backing, speed > 0, speed < 0))  # reverse only to get out, then only until free
         # Backing up is only safe over ground just driven forward: the laser does not see behind.
         reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= self._reverse_room)

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+from stage_sim.core.laser_reading import LaserReading
+from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.core.simulation import Simulation
 
 

@@ -31,7 +31,8 @@ from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from stage_sim.core.reactive import LaserReading, WanderConfig, Wanderer
+from stage_sim.core.laser_reading import LaserReading
+from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.ros.interrupts import stop_requests
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)

