@@ -36,6 +36,9 @@ from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.ros.interrupts import stop_requests
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+# Only the newest scan matters: a backlog (a slow start, a loaded machine) would replay stale scans, each
+# answered with a command for where the robot no longer is.
+NEWEST_SCAN = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 ODOM_KEPT = 50  # recent odometry messages kept for pairing with scans by stamp
 
@@ -70,7 +73,7 @@ class Wander(Node):
         self._odometry: deque[tuple[int, tuple[float, float, float]]] = deque(maxlen=ODOM_KEPT)
         self._pending: LaserScan | None = None  # a scan waiting for the odometry of its stamp
         self.publisher = self.create_publisher(Twist, "cmd_vel", RELIABLE_10)
-        self.create_subscription(LaserScan, "base_scan", self.on_scan, RELIABLE_10)
+        self.create_subscription(LaserScan, "base_scan", self.on_scan, NEWEST_SCAN)
         self.create_subscription(Odometry, "odom", self.on_odom, RELIABLE_10)
         self.create_subscription(TFMessage, "/tf_static", self.on_tf_static, LATCHED)
 
