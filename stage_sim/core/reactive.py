@@ -16,6 +16,7 @@ ever zero, so the robot never stands still, and none brings the body closer to a
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,6 +59,13 @@ DOOR_EXIT = 0.6  # m past a doorway at which its passage is over
 DOOR_BEYOND = np.array([1.0, 2.0, 3.0])  # m past a doorway where new space is looked for
 DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was visited this recently
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
+TRAIL_STEP = 0.05  # m between the remembered positions of the path driven forward, which a retreat retraces
+TRAIL_LENGTH = 1.5  # m of that path kept: enough to back out of a dead end the body cannot turn in
+WIGGLE_S = 3.0  # s of going nowhere (within WIGGLE_MOVE m and WIGGLE_TURN rad) that starts a retreat
+WIGGLE_MOVE, WIGGLE_TURN = 0.05, 0.35
+RETREAT_S = 12.0  # s a retreat may last
+RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
+RETREAT_LOOK = 0.3  # m back along the trail of the point a retreat steers for
 
 
 @dataclass(frozen=True)
@@ -127,6 +135,10 @@ class Wanderer:
         self._escape_until = -math.inf
         self._backing_until = -math.inf
         self._reverse_room = 0.0  # m the robot may back up: along the path it came, never into unseen space
+        self._trail: deque[tuple[float, float]] = deque(maxlen=round(TRAIL_LENGTH / TRAIL_STEP) + 1)
+        self._recent: deque[tuple[float, float, float, float]] = deque()  # (time, x, y, net turn), last WIGGLE_S
+        self._retreat_until = -math.inf  # backing out along the trail until then (or until free to turn)
+        self._retreat_from = (0.0, 0.0)
         self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
 
     def decide(
@@ -141,15 +153,21 @@ class Wanderer:
                 pose[1] - self._pose[1])
             self._reverse_room = min(max(self._reverse_room + forward, 0.0), REVERSE_ROOM_MAX)
             self._tour_turn += turn
+            self._extend_trail(pose, forward)
         self._pose, self._time = pose, time
         points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
-        if self._stuck(time, pose):  # give up on new space around here, back off, then head somewhere else
-            if self._door is not None:
-                self._leave_door(time, given_up=True)
-            self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
+        if self._stuck(time, pose) or self._wiggling(time, pose):
+            self._retreat(time, pose)  # give up on new space around here, back out, then head somewhere else
+        if time < self._retreat_until:
+            steer = self._retreat_turn(points, pose, time)
+            if steer is not None:
+                command = self._plan(points, allowance, moving, math.pi, time, retreat_turn=steer)
+                if command[0] < 0:
+                    self.command = command
+                    return command
+            self._retreat_until = -math.inf  # out (or no way back): turn round and head somewhere open
             self._escape(time, self._pick_heading(points, pose))
-            self._backing_until = time + 2 * BACKING_S
         heading = None
         if time >= self._escape_until:
             self._choose_mode(time, points, pose, reading)
@@ -230,6 +248,65 @@ class Wanderer:
             self._progress = [(time, pose[0], pose[1])]
             return True
         return False
+
+    def _wiggling(self, time: float, pose: tuple[float, float, float]) -> bool:
+        """True when for WIGGLE_S the robot has neither moved nor turned (dithering between turns in a spot
+        too tight to turn round in); never while retreating."""
+        recent = self._recent
+        recent.append((time, pose[0], pose[1], float(self._odometry[1])))
+        while time - recent[0][0] > WIGGLE_S:
+            recent.popleft()
+        if time < self._retreat_until or time - recent[0][0] < WIGGLE_S - 1e-6:
+            return False
+        history = np.array(recent)
+        moved = np.hypot(history[:, 1] - pose[0], history[:, 2] - pose[1]).max()
+        if moved < WIGGLE_MOVE and np.ptp(history[:, 3]) < WIGGLE_TURN:
+            recent.clear()
+            return True
+        return False
+
+    def _extend_trail(self, pose: tuple[float, float, float], forward: float) -> None:
+        """Remember the path driven forward (every TRAIL_STEP); backing up along it uses it up."""
+        trail = self._trail
+        if forward > 0 and (not trail or math.hypot(pose[0] - trail[-1][0], pose[1] - trail[-1][1]) >= TRAIL_STEP):
+            trail.append((pose[0], pose[1]))
+        elif forward < 0:
+            while trail and math.hypot(pose[0] - trail[-1][0], pose[1] - trail[-1][1]) < TRAIL_STEP:
+                trail.pop()
+
+    def _retreat(self, time: float, pose: tuple[float, float, float]) -> None:
+        """Start backing out along the trail; what lay ahead counts as visited so it is not tried again at once."""
+        if self._door is not None:
+            self._leave_door(time, given_up=True)
+        self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
+        self._progress = [(time, pose[0], pose[1])]
+        self._retreat_until = time + RETREAT_S
+        self._retreat_from = (pose[0], pose[1])
+
+    def _retreat_turn(self, points: np.ndarray, pose: tuple, time: float) -> float | None:
+        """The turn rate that backs the robot along its trail (pure pursuit in reverse), None when the retreat
+        is over: far enough back and free to turn round in place, or out of trail."""
+        backed = math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1])
+        turn_free = self._radius + self.config.safety_distance + TOLERANCE
+        if backed >= RETREAT_MIN and np.hypot(points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free:
+            return None
+        trail = np.array(self._trail).reshape(-1, 2)[::-1]  # newest first
+        if not len(trail):
+            return None
+        local = _compose(pose, trail, inverse=True)
+        far = np.flatnonzero(np.hypot(local[:, 0], local[:, 1]) >= RETREAT_LOOK)
+        x, y = local[far[0] if len(far) else -1]
+        if x >= 0:  # the trail is not behind the robot: it cannot be retraced in reverse
+            return None
+        speed = float(self.commands[:, 0].min())
+        return speed * 2 * y / (x * x + y * y)
+
+    def _trail_length(self) -> float:
+        """Metres of remembered path behind the robot (the room a retreat has)."""
+        if not self._trail or self._pose is None:
+            return 0.0
+        path = np.array([self._pose[:2], *reversed(self._trail)])
+        return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
     # -- behaviours -------------------------------------------------------------------------------
 
@@ -349,10 +426,12 @@ class Wanderer:
     # -- the safety-checked choice -----------------------------------------------------------------
 
     def _plan(
-        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, time: float
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, time: float,
+        retreat_turn: float | None = None,
     ) -> tuple[float, ...]:
         """The best command for ``heading`` among those whose arc keeps the body clear of every point, moving
-        points (other robots) being given room that grows at ``moving_speed`` along the arc."""
+        points (other robots) being given room that grows at ``moving_speed`` along the arc; retreating, the
+        reverse command nearest ``retreat_turn`` if any is clear."""
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
         distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
@@ -362,7 +441,10 @@ class Wanderer:
         points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
         moving = moving[near][order]
         now = self._body_distance(points[:, 0], points[:, 1])
-        backing = time < self._backing_until  # getting out of a tight spot: half the margin will do
+        retreating = retreat_turn is not None
+        backing = retreating or time < self._backing_until  # getting out of a tight spot: half the margin will do
+        if retreating:  # retracing where the body has just been: no allowance for odometry drift is needed
+            allowance = np.zeros_like(allowance)
         keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
                     + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
         limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
@@ -388,8 +470,12 @@ class Wanderer:
                  - (1.0 if door else 8.0) * self._cramped(points)
                  - np.where(backing, speed > 0, speed < 0))  # reverse only to get out, then only until free
         # Backing up is only safe over ground just driven forward: the laser does not see behind.
-        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= self._reverse_room)
+        room = self._trail_length() if retreating else self._reverse_room
+        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= room)
         admissible = (safe_until >= ADMISSIBLE_S) & reversible
+        if retreating and (admissible & (speed < 0)).any():
+            admissible &= speed < 0
+            score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
         if not admissible.any():  # nothing stays clear long enough: of what may be done, whatever stays clear
             longest = np.where(reversible, safe_until, -1.0)  # longest, then with least intrusion in its first step
             admissible = longest == longest.max()
