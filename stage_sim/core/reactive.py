@@ -61,8 +61,8 @@ DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was 
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 TRAIL_STEP = 0.05  # m between the remembered positions of the path driven forward, which a retreat retraces
 TRAIL_LENGTH = 1.5  # m of that path kept: enough to back out of a dead end the body cannot turn in
-WIGGLE_S = 3.0  # s of going nowhere (within WIGGLE_MOVE m and WIGGLE_TURN rad) that starts a retreat
-WIGGLE_MOVE, WIGGLE_TURN = 0.05, 0.35
+STILL_S = 1.5  # s of standing still (within STILL_MOVE m and STILL_TURN rad of one pose) that starts a retreat
+STILL_MOVE, STILL_TURN = 0.05, 0.1  # the run summaries' notion of standing still (dithering included)
 RETREAT_S = 12.0  # s a retreat may last
 RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
 RETREAT_LOOK = 0.3  # m back along the trail of the point a retreat steers for
@@ -136,7 +136,7 @@ class Wanderer:
         self._backing_until = -math.inf
         self._reverse_room = 0.0  # m the robot may back up: along the path it came, never into unseen space
         self._trail: deque[tuple[float, float]] = deque(maxlen=round(TRAIL_LENGTH / TRAIL_STEP) + 1)
-        self._recent: deque[tuple[float, float, float, float]] = deque()  # (time, x, y, net turn), last WIGGLE_S
+        self._still_since: tuple[float, tuple[float, float, float]] | None = None  # (time, pose) a stop began
         self._retreat_until = -math.inf  # backing out along the trail until then (or until free to turn)
         self._retreat_from = (0.0, 0.0)
         self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
@@ -157,7 +157,7 @@ class Wanderer:
         self._pose, self._time = pose, time
         points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
-        if self._stuck(time, pose) or self._wiggling(time, pose):
+        if self._stuck(time, pose) or self._standing_still(time, pose):
             self._retreat(time, pose)  # give up on new space around here, back out, then head somewhere else
         if time < self._retreat_until:
             steer = self._retreat_turn(points, pose, time)
@@ -249,20 +249,14 @@ class Wanderer:
             return True
         return False
 
-    def _wiggling(self, time: float, pose: tuple[float, float, float]) -> bool:
-        """True when for WIGGLE_S the robot has neither moved nor turned (dithering between turns in a spot
-        too tight to turn round in); never while retreating."""
-        recent = self._recent
-        recent.append((time, pose[0], pose[1], float(self._odometry[1])))
-        while time - recent[0][0] > WIGGLE_S:
-            recent.popleft()
-        if time < self._retreat_until or time - recent[0][0] < WIGGLE_S - 1e-6:
-            return False
-        history = np.array(recent)
-        moved = np.hypot(history[:, 1] - pose[0], history[:, 2] - pose[1]).max()
-        if moved < WIGGLE_MOVE and np.ptp(history[:, 3]) < WIGGLE_TURN:
-            recent.clear()
-            return True
+    def _standing_still(self, time: float, pose: tuple[float, float, float]) -> bool:
+        """True when the robot has stayed near one pose for STILL_S (dithering between small turns in a spot
+        too tight to turn round in, say); never while retreating."""
+        if self._still_since is not None:
+            since, (x, y, yaw) = self._still_since
+            if math.hypot(pose[0] - x, pose[1] - y) < STILL_MOVE and abs(wrap(pose[2] - yaw)) < STILL_TURN:
+                return time - since >= STILL_S - 1e-6 and time >= self._retreat_until
+        self._still_since = (time, pose)
         return False
 
     def _extend_trail(self, pose: tuple[float, float, float], forward: float) -> None:
@@ -280,6 +274,7 @@ class Wanderer:
             self._leave_door(time, given_up=True)
         self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
         self._progress = [(time, pose[0], pose[1])]
+        self._still_since = (time, pose)
         self._retreat_until = time + RETREAT_S
         self._retreat_from = (pose[0], pose[1])
 

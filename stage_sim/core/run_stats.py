@@ -12,13 +12,16 @@ import numpy as np
 
 from stage_sim.core.simulation import Simulation
 
-STOP_SPEED = 0.01  # m/s and rad/s below which a robot counts as standing still
+# A robot stands still while it stays this close to one pose (m, rad): dithering between tiny turns or
+# creeping back and forth is standing still too, not just a zero velocity.
+STOP_RADIUS, STOP_TURN = 0.05, 0.1
 
 
 class RunStats:
     """Per-robot distance, stall events, longest stop and coverage, from the ground truth of every step.
 
-    Coverage is the share of the map's free cells (``cell`` m squares whose fine cells are all free, 4-connected
+    A stop lasts from a pose until the robot first gets STOP_RADIUS or STOP_TURN away from it. Coverage is
+    the share of the map's free cells (``cell`` m squares whose fine cells are all free, 4-connected
     to a robot's start) that came within ``radius`` of the robot: a disc is stamped on a coarse grid wherever
     the robot enters a new cell.
     """
@@ -43,7 +46,8 @@ class RunStats:
         self.distance = np.zeros(n)
         self.stall_events = np.zeros(n, dtype=np.int64)
         self.longest_stop = np.zeros(n)
-        self._stopped_since = np.full(n, math.nan)
+        self._anchors = sim.true_poses.copy()  # where each robot's current (possible) stop began, and when
+        self._anchor_times = np.full(n, sim.sim_time)
         self._poses = sim.true_poses.copy()
         self._stalled = sim.stalled.copy()
         self._time = sim.sim_time
@@ -75,14 +79,13 @@ class RunStats:
             return
         poses = sim.true_poses
         moved = np.hypot(*(poses[:, :2] - self._poses[:, :2]).T)
-        turned = np.abs((poses[:, 2] - self._poses[:, 2] + math.pi) % (2 * math.pi) - math.pi)
         self.distance += moved
         self.stall_events += sim.stalled & ~self._stalled
-        still = (moved / dt < STOP_SPEED) & (turned / dt < STOP_SPEED)
-        self._stopped_since = np.where(still, np.where(np.isnan(self._stopped_since), self._time,
-                                                       self._stopped_since), math.nan)
-        stopped_for = np.where(still, sim.sim_time - self._stopped_since, 0.0)
-        self.longest_stop = np.maximum(self.longest_stop, stopped_for)
+        away = (np.hypot(*(poses[:, :2] - self._anchors[:, :2]).T) >= STOP_RADIUS) | (
+            np.abs((poses[:, 2] - self._anchors[:, 2] + math.pi) % (2 * math.pi) - math.pi) >= STOP_TURN)
+        self._anchors[away] = poses[away]
+        self._anchor_times[away] = sim.sim_time
+        self.longest_stop = np.maximum(self.longest_stop, sim.sim_time - self._anchor_times)
         self._poses, self._stalled, self._time = poses.copy(), sim.stalled.copy(), sim.sim_time
         for robot in range(len(poses)):
             self._stamp(robot)
