@@ -9,8 +9,10 @@ that wandering never ends), and when none is in view a *tour* takes the open dir
 side (a left- or right-hand rule: through every door and round every room), the side redrawn by a seeded
 generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
 body, simulated along the command's arc, keeps clear of every point (a dynamic-window check). No command is
-ever zero, so the robot never stands still, and none brings the body closer to a point than
-``safety_distance`` (or than it already is), so it never drives into what it has seen.
+ever zero, and none brings the body closer to a point than ``safety_distance`` (or than it already is), so it
+never drives into what it has seen. Where no command gets anywhere (a dead end too narrow to turn round in, so
+the robot dithers in place), it retraces in reverse the path it last drove forward, the only ground behind
+it known to be clear, until it can turn round.
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was 
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 TRAIL_STEP = 0.05  # m between the remembered positions of the path driven forward, which a retreat retraces
 TRAIL_LENGTH = 1.5  # m of that path kept: enough to back out of a dead end the body cannot turn in
-STILL_S = 1.5  # s of standing still (within STILL_MOVE m and STILL_TURN rad of one pose) that starts a retreat
+STILL_S = 1.0  # s of standing still (within STILL_MOVE m and STILL_TURN rad of one pose) that starts a retreat
 STILL_MOVE, STILL_TURN = 0.05, 0.1  # the run summaries' notion of standing still (dithering included)
 RETREAT_S = 12.0  # s a retreat may last
 RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
