@@ -58,16 +58,18 @@ ESCAPE_S = 4.0  # s spent heading away from a dead end or a stuck spot
 BACKING_S = 1.0  # s a reverse manoeuvre is kept up before driving forward again
 DOOR_S = 30.0  # s to get through a narrow doorway before giving it up
 DOOR_EXIT = 0.6  # m past a doorway at which its passage is over
+DOOR_THROUGH = 0.3  # m past a doorway at which the body is through it (its passage may end early there)
 DOOR_BEYOND = np.array([1.0, 2.0, 3.0])  # m past a doorway where new space is looked for
 DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was visited this recently
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 TRAIL_STEP = 0.05  # m between the remembered positions of the path driven forward, which a retreat retraces
 TRAIL_LENGTH = 1.5  # m of that path kept: enough to back out of a dead end the body cannot turn in
-STILL_S = 1.0  # s of standing still (within STILL_MOVE m and STILL_TURN rad of one pose) that starts a retreat
-STILL_MOVE, STILL_TURN = 0.05, 0.1  # the run summaries' notion of standing still (dithering included)
+STILL_S = 0.5  # s of going nowhere: within STILL_MOVE m, turning to and fro by at most STILL_TURN rad in all
+STILL_MOVE, STILL_TURN, STILL_NET = 0.05, 0.25, 0.05  # net turn below STILL_NET rad: dithering, not a slow turn
 RETREAT_S = 12.0  # s a retreat may last
 RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
 RETREAT_LOOK = 0.3  # m back along the trail of the point a retreat steers for
+COMMIT_S = 2.0  # s of turning one way only when dithering and unable to back out
 
 
 @dataclass(frozen=True)
@@ -138,9 +140,11 @@ class Wanderer:
         self._backing_until = -math.inf
         self._reverse_room = 0.0  # m the robot may back up: along the path it came, never into unseen space
         self._trail: deque[tuple[float, float]] = deque(maxlen=round(TRAIL_LENGTH / TRAIL_STEP) + 1)
-        self._still_since: tuple[float, tuple[float, float, float]] | None = None  # (time, pose) a stop began
+        self._recent: deque[tuple[float, float, float, float]] = deque()  # (time, x, y, net turn) over STILL_S
         self._retreat_until = -math.inf  # backing out along the trail until then (or until free to turn)
         self._retreat_from = (0.0, 0.0)
+        self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
+        self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
         self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
 
     def decide(
@@ -159,8 +163,15 @@ class Wanderer:
         self._pose, self._time = pose, time
         points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
-        if self._stuck(time, pose) or self._standing_still(time, pose):
-            self._retreat(time, pose)  # give up on new space around here, back out, then head somewhere else
+        if self._stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
+            self._retreat(time, pose, give_up=True)
+        elif self._standing_still(time, pose):
+            if self._door is not None and self._door.progress(pose)[0] > DOOR_THROUGH:
+                self._leave_door(time, given_up=False)  # through, yet not out along the axis: carry on from here
+            elif time < self._commit[0]:  # turning one way did not get it going either: back off a little
+                self._retreat(time, pose, give_up=False)
+            else:  # dithering between turns: turn one way only for a while
+                self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
         if time < self._retreat_until:
             steer = self._retreat_turn(points, pose, time)
             if steer is not None:
@@ -168,8 +179,13 @@ class Wanderer:
                 if command[0] < 0:
                     self.command = command
                     return command
-            self._retreat_until = -math.inf  # out (or no way back): turn round and head somewhere open
-            self._escape(time, self._pick_heading(points, pose))
+            self._retreat_until = -math.inf
+            self._recent.clear()  # standing still is judged afresh from here
+            if math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1]) < TRAIL_STEP:
+                # No way back at all: stop dithering by turning one way only for a while.
+                self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
+            if self._retreat_gave_up:  # out (or no way back): turn round and head somewhere open
+                self._escape(time, self._pick_heading(points, pose))
         heading = None
         if time >= self._escape_until:
             self._choose_mode(time, points, pose, reading)
@@ -252,14 +268,21 @@ class Wanderer:
         return False
 
     def _standing_still(self, time: float, pose: tuple[float, float, float]) -> bool:
-        """True when the robot has stayed near one pose for STILL_S (dithering between small turns in a spot
-        too tight to turn round in, say); never while retreating."""
-        if self._still_since is not None:
-            since, (x, y, yaw) = self._still_since
-            if math.hypot(pose[0] - x, pose[1] - y) < STILL_MOVE and abs(wrap(pose[2] - yaw)) < STILL_TURN:
-                return time - since >= STILL_S - 1e-6 and time >= self._retreat_until
-        self._still_since = (time, pose)
-        return False
+        """True when for STILL_S the robot has got nowhere: dithering between small turns or creeping to and
+        fro (never while retreating)."""
+        recent = self._recent
+        recent.append((time, pose[0], pose[1], float(self._odometry[1])))
+        while time - recent[0][0] > STILL_S + 1e-6:
+            recent.popleft()
+        if time < self._retreat_until or time - recent[0][0] < STILL_S - 1e-6:
+            return False
+        history = np.array(recent)
+        moved = np.hypot(history[:, 1] - pose[0], history[:, 2] - pose[1]).max()
+        turns = history[:, 3]
+        still = moved < STILL_MOVE and np.ptp(turns) < STILL_TURN and abs(turns[-1] - turns[0]) < STILL_NET
+        if still:
+            recent.clear()
+        return bool(still)
 
     def _extend_trail(self, pose: tuple[float, float, float], forward: float) -> None:
         """Remember the path driven forward (every TRAIL_STEP); backing up along it uses it up."""
@@ -270,22 +293,25 @@ class Wanderer:
             while trail and math.hypot(pose[0] - trail[-1][0], pose[1] - trail[-1][1]) < TRAIL_STEP:
                 trail.pop()
 
-    def _retreat(self, time: float, pose: tuple[float, float, float]) -> None:
-        """Start backing out along the trail; what lay ahead counts as visited so it is not tried again at once."""
-        if self._door is not None:
-            self._leave_door(time, given_up=True)
-        self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
-        self._progress = [(time, pose[0], pose[1])]
-        self._still_since = (time, pose)
+    def _retreat(self, time: float, pose: tuple[float, float, float], give_up: bool) -> None:
+        """Start backing out along the trail; giving up, what lay ahead counts as visited so it is not tried
+        again at once, and the retreat goes on until the robot can turn round."""
+        if give_up:
+            if self._door is not None:
+                self._leave_door(time, given_up=True)
+            self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
+        self._retreat_gave_up = give_up
+        self._recent.clear()
         self._retreat_until = time + RETREAT_S
         self._retreat_from = (pose[0], pose[1])
 
     def _retreat_turn(self, points: np.ndarray, pose: tuple, time: float) -> float | None:
         """The turn rate that backs the robot along its trail (pure pursuit in reverse), None when the retreat
-        is over: far enough back and free to turn round in place, or out of trail."""
+        is over: RETREAT_MIN back (and, giving up, free to turn round in place), or out of trail."""
         backed = math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1])
         turn_free = self._radius + self.config.safety_distance + TOLERANCE
-        if backed >= RETREAT_MIN and np.hypot(points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free:
+        if backed >= RETREAT_MIN and (not self._retreat_gave_up or np.hypot(
+                points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free):
             return None
         trail = np.array(self._trail).reshape(-1, 2)[::-1]  # newest first
         if not len(trail):
@@ -465,7 +491,8 @@ class Wanderer:
                  + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - self.command[2]) / config.turn_rate
                  - (1.0 if door else 8.0) * self._cramped(points)
-                 - np.where(backing, speed > 0, speed < 0))  # reverse only to get out, then only until free
+                 - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
+                 - 3.0 * ((time < self._commit[0]) & (self.commands[:, 2] * self._commit[1] < 0)))
         # Backing up is only safe over ground just driven forward: the laser does not see behind.
         room = self._trail_length() if retreating else self._reverse_room
         reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= room)
