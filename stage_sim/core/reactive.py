@@ -10,9 +10,10 @@ side (a left- or right-hand rule: through every door and round every room), the 
 generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
 body, simulated along the command's arc, keeps clear of every point (a dynamic-window check). No command is
 ever zero, and none brings the body closer to a point than ``safety_distance`` (or than it already is), so it
-never drives into what it has seen. Where no command gets anywhere (a dead end too narrow to turn round in, so
-the robot dithers in place), it retraces in reverse the path it last drove forward, the only ground behind
-it known to be clear, until it can turn round.
+never drives into what it has seen. Dithering in place (no net motion for half a second) is broken by turning
+one way only, then by backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot
+gives up what lay ahead and retraces in reverse the path it last drove forward, the only ground behind it
+known to be clear, until it can turn round.
 """
 
 from __future__ import annotations
