@@ -172,21 +172,12 @@ class Wanderer:
             elif time < self._commit[0]:  # turning one way did not get it going either: back off a little
                 self._retreat(time, pose, give_up=False)
             else:  # dithering between turns: turn one way only for a while
-                self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
+                self._commit_turn(time)
         if time < self._retreat_until:
-            steer = self._retreat_turn(points, pose, time)
-            if steer is not None:
-                command = self._plan(points, allowance, moving, math.pi, time, retreat_turn=steer)
-                if command[0] < 0:
-                    self.command = command
-                    return command
-            self._retreat_until = -math.inf
-            self._recent.clear()  # standing still is judged afresh from here
-            if math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1]) < TRAIL_STEP:
-                # No way back at all: stop dithering by turning one way only for a while.
-                self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
-            if self._retreat_gave_up:  # out (or no way back): turn round and head somewhere open
-                self._escape(time, self._pick_heading(points, pose))
+            command = self._retreat_command(points, allowance, moving, pose, time)
+            if command is not None:
+                self.command = command
+                return command
         heading = None
         if time >= self._escape_until:
             self._choose_mode(time, points, pose, reading)
@@ -306,10 +297,36 @@ class Wanderer:
         self._retreat_until = time + RETREAT_S
         self._retreat_from = (pose[0], pose[1])
 
-    def _retreat_turn(self, points: np.ndarray, pose: tuple, time: float) -> float | None:
+    def _commit_turn(self, time: float) -> None:
+        """Turn only the way the robot is turning now, for COMMIT_S (dithering between the two ends nowhere)."""
+        self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
+
+    def _backed(self, pose: tuple) -> float:
+        """Metres from where the current retreat began."""
+        return math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1])
+
+    def _retreat_command(
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, pose: tuple, time: float
+    ) -> tuple[float, ...] | None:
+        """The next reverse command of the retreat; None once it is over (then, giving up, escape somewhere
+        open; with no way back at all, turn one way only for a while)."""
+        steer = self._retreat_turn(points, pose)
+        if steer is not None:
+            command = self._plan(points, allowance, moving, math.pi, time, retreat_turn=steer)
+            if command[0] < 0:
+                return command
+        self._retreat_until = -math.inf
+        self._recent.clear()  # standing still is judged afresh from here
+        if self._backed(pose) < TRAIL_STEP:
+            self._commit_turn(time)
+        if self._retreat_gave_up:
+            self._escape(time, self._pick_heading(points, pose))
+        return None
+
+    def _retreat_turn(self, points: np.ndarray, pose: tuple) -> float | None:
         """The turn rate that backs the robot along its trail (pure pursuit in reverse), None when the retreat
         is over: RETREAT_MIN back (and, giving up, free to turn round in place), or out of trail."""
-        backed = math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1])
+        backed = self._backed(pose)
         turn_free = self._radius + self.config.safety_distance + TOLERANCE
         if backed >= RETREAT_MIN and (not self._retreat_gave_up or np.hypot(
                 points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free):
