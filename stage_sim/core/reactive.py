@@ -5,9 +5,10 @@ nearby points that have left the laser's field of view (the rear is blind, yet t
 rear corners through it), each with a safety allowance that grows with the odometry error accumulated since
 it was seen; (2) picks a desired heading: *explore* heads for the open direction with the most space the
 robot has not yet passed near (a coarse :class:`VisitMap` of the odometry frame, forgotten after a while so
-that wandering never ends), and when none is in view a *tour* takes the open direction nearest round to one
-side (a left- or right-hand rule: through every door and round every room), the side redrawn by a seeded
-generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
+that wandering never ends); when none is in view it *seeks*: follows the shortest route through the free
+space its laser has shown it (:class:`SeenSpace`) to the nearest place not yet visited, such as a room glimpsed
+through a door; with none left a *tour* takes the open direction nearest round to one side (a left- or
+right-hand rule: through every door and round every room), the side redrawn by a seeded generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
 body, simulated along the command's arc, keeps clear of every point (a dynamic-window check). No command is
 ever zero, and none brings the body closer to a point than ``safety_distance`` (or than it already is), so it
 never drives into what it has seen. Dithering in place (no net motion for half a second) is broken by turning
@@ -26,6 +27,7 @@ import numpy as np
 
 from stage_sim.core.doorways import DoorPassage, Doorway, find_doorways
 from stage_sim.core.laser_reading import LaserReading, wrap
+from stage_sim.core.seen_space import SeenSpace, route_heading
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
 from stage_sim.core.visit_map import VisitMap
 
@@ -71,6 +73,12 @@ RETREAT_S = 12.0  # s a retreat may last
 RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
 RETREAT_LOOK = 0.3  # m back along the trail of the point a retreat steers for
 COMMIT_S = 2.0  # s of turning one way only when dithering and unable to back out
+ROUTE_S = 3.0  # s a route to far new space is followed before it is planned afresh
+ROUTE_AHEAD = 1.0  # m along the route of the point a seeking robot heads for
+ROUTE_OFF = 1.0  # m off its route at which a seeking robot plans a new one
+ROUTE_SPEED = 0.25  # m/s at least along a route: slower, its goal is given up (marked visited)
+ROUTE_SLACK_S = 30.0  # s allowed on top of that for doors and other robots
+GOAL_RADIUS = 1.0  # m around a goal given up on that counts as visited
 
 
 @dataclass(frozen=True)
@@ -99,6 +107,13 @@ def _compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool
     return np.stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]], -1)
 
 
+def _near_route(points: np.ndarray, route: np.ndarray | None) -> bool:
+    """Whether any of the points (P, 2) lies within half a metre of the route."""
+    if route is None:
+        return False
+    return bool((np.hypot(points[:, None, 0] - route[:, 0], points[:, None, 1] - route[:, 1]) < 0.5).any())
+
+
 class Wanderer:
     """Decides a velocity command per scan; the same seed and inputs give the same commands."""
 
@@ -112,6 +127,9 @@ class Wanderer:
         self._boxes = boxes
         self._front = float(boxes[:, 1].max())
         self._half_width = float(np.abs(boxes[:, 2:]).max())
+        x_min, x_max, y_min, y_max = boxes[0]  # the chassis, sampled finely enough to touch every cell under it
+        grid = np.meshgrid(np.linspace(x_min, x_max, 6), np.linspace(y_min, y_max, 5))
+        self._body_points = np.stack([grid[0].ravel(), grid[1].ravel()], axis=-1)
         self._radius = float(np.hypot(np.abs(boxes[:, :2]).max(axis=1), np.abs(boxes[:, 2:]).max(axis=1)).max())
         # Candidates grouped by linear speed, with how far from the centre a point can matter to them.
         speeds = np.round(np.hypot(self.commands[:, 0], self.commands[:, 1]), 6)
@@ -125,10 +143,14 @@ class Wanderer:
         self._time = 0.0
         self.command = (0.0, 0.0, 0.0)
         self.visits = VisitMap(reach=self.config.visit_reach)
+        self.seen = SeenSpace()
+        self._route: np.ndarray | None = None  # seeking: the route (odometry frame) to the nearest new place
+        self._route_until = -math.inf  # when the route is planned afresh
+        self._goal: tuple[np.ndarray, float] | None = None  # the place being sought and when it is given up
         offsets = np.arange(-GIVE_UP_RADIUS, GIVE_UP_RADIUS + 0.01, self.visits.cell)
         disc = np.stack(np.meshgrid(offsets, offsets), axis=-1).reshape(-1, 2)
         self._give_up_disc = disc[np.hypot(disc[:, 0], disc[:, 1]) <= GIVE_UP_RADIUS]
-        self.mode = "explore"  # or "tour", or "door" while passing self._door
+        self.mode = "explore"  # or "seek", "tour", or "door" while passing self._door
         self._door: DoorPassage | None = None
         self._door_widths = (2 * (self._half_width + self.config.safety_distance) + 0.02,
                              2 * (self._half_width + TOUR_GAP) + 0.05)  # narrower than explore and tour see
@@ -164,6 +186,7 @@ class Wanderer:
         self._pose, self._time = pose, time
         points, allowance, moving = self._observe(reading, pose)
         self.visits.stamp(pose[0], pose[1], time)
+        self._see(reading, pose)
         if self._stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
             self._retreat(time, pose, give_up=True)
         elif self._standing_still(time, pose):
@@ -183,6 +206,8 @@ class Wanderer:
             self._choose_mode(time, points, pose, reading)
             if self.mode == "door":
                 heading = self._door_heading(reading, pose, time)
+            if self.mode == "seek":
+                heading = route_heading(self._route, pose, ROUTE_AHEAD)[0]
             if self.mode == "tour":
                 heading = self._tour_heading(points)
                 if heading is None:  # a dead end: turn round, away from the wall
@@ -221,6 +246,16 @@ class Wanderer:
         unique.sort()  # the first of a cell is the freshest
         self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
         return points, allowance, moving
+
+    def _see(self, reading: LaserReading, pose: tuple) -> None:
+        """Add the scan to the map of seen space: beams that hit or reached their range limit (NaN and
+        too-near readings say nothing)."""
+        ranges = np.asarray(reading.ranges, dtype=np.float64)
+        hit = reading.hits()
+        valid = hit | (ranges >= reading.range_max)  # includes +inf
+        ends = _compose(pose, reading.beam_ends(np.where(hit, ranges, reading.range_max))[valid])
+        origin = _compose(pose, np.array([reading.laser_pose[:2]]))[0]
+        self.seen.observe(origin, ends, hit[valid], _compose(pose, self._body_points))
 
     def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
         """Per beam: whether it hits something where the previous scan saw free space (its beam, or a
@@ -376,10 +411,35 @@ class Wanderer:
                 weights = value**3
                 self._heading = float(wrap(pose[2] + self.rng.choice(BEARINGS, p=weights / weights.sum())))
             self.mode = "explore"
-        elif self.mode == "explore" or time >= self._tour_until or self._side * self._tour_turn >= 2 * math.pi:
+        elif self._seek(time, pose):
+            self.mode = "seek"
+        elif self.mode in ("explore", "seek") or time >= self._tour_until or self._side * self._tour_turn >= 2 * math.pi:
             self.mode, self._tour_turn = "tour", 0.0  # a full turn towards the wall: circling an island
             self._tour_until = time + self.rng.uniform(*self.config.tour_s)
             self._side = float(self.rng.choice((-1.0, 1.0)))
+
+    def _seek(self, time: float, pose: tuple) -> bool:
+        """Whether there is a route to follow to new space out of view (planned afresh every ROUTE_S, when
+        its goal has been visited or the robot is off it); a goal not reached in time is given up."""
+        since = time - self.config.visit_memory_s
+        route = self._route
+        if route is None and time < self._route_until:  # none found lately: do not search on every look
+            return False
+        if (route is not None and time < self._route_until and route_heading(route, pose, 0.0)[1] < ROUTE_OFF
+                and not self.visits.visited_since(route[-1:], since)[0]):
+            return True
+        self._route = route = self.seen.route(pose[:2], lambda xy: ~self.visits.visited_since(xy, since))
+        self._route_until = time + ROUTE_S
+        if route is None:
+            return False
+        length = float(np.hypot(*np.diff(route, axis=0).T).sum())
+        if self._goal is None or np.hypot(*(route[-1] - self._goal[0])) > GOAL_RADIUS:  # a new goal
+            self._goal = (route[-1], time + length / ROUTE_SPEED + ROUTE_SLACK_S)
+        elif time > self._goal[1]:  # the same goal for too long: it cannot be reached from here
+            self.visits.mark(route[-1] + self._give_up_disc[np.hypot(*self._give_up_disc.T) <= GOAL_RADIUS], time)
+            self._route = None
+            return False
+        return True
 
     def _doorways(self, reading: LaserReading) -> list[Doorway]:
         return find_doorways(reading, *self._door_widths)
@@ -388,7 +448,8 @@ class Wanderer:
         """The nearest narrow doorway in view whose far side is new (or, touring, not visited lately)."""
         since = time - (DOOR_RECENT_S if self.mode == "tour" else self.config.visit_memory_s)
         passages = [DoorPassage.seen_from(doorway, pose, time + DOOR_S) for doorway in self._doorways(reading)]
-        fresh = [p for p in passages if (~self.visits.visited_since(p.beyond(DOOR_BEYOND), since)).sum() >= 2]
+        fresh = [p for p in passages if (~self.visits.visited_since(p.beyond(DOOR_BEYOND), since)).sum() >= 2
+                 or (self.mode == "seek" and _near_route(p.beyond(DOOR_BEYOND[:1]), self._route))]
         return min(fresh, key=lambda p: -p.progress(pose)[0], default=None)
 
     def _door_heading(self, reading: LaserReading, pose: tuple, time: float) -> float | None:

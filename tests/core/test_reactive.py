@@ -244,3 +244,19 @@ def test_same_seed_same_run_and_another_seed_another(tmp_path: Path) -> None:
     other = closed_loop(tmp_path, robot, 60.0, seed=4).sim.true_poses.copy()
     np.testing.assert_array_equal(first, again)
     assert not np.allclose(first, other)
+
+
+def test_with_nothing_new_in_view_it_heads_back_for_new_space_it_saw_earlier() -> None:
+    # First it looks down a 1.5 m-wide corridor (free for more than 5 m ahead); then, turned round, it faces a
+    # wall 0.7 m away with only ground it has visited (within 1 m) in view. Rather than tour, it seeks the far
+    # corridor it saw.
+    wanderer = Wanderer(seed=0)
+    corridor = [(-1.0, -0.75, 8.0, -0.75), (-1.0, 0.75, 8.0, 0.75)]
+    wanderer.decide(scan_of_segments(corridor), 0.0, (0.25, 0.25, 0.0))
+    facing_wall = [(0.7, -0.75, 0.7, 0.75), (-8.0, -0.75, 0.7, -0.75), (-8.0, 0.75, 0.7, 0.75)]
+    for time in (0.6, 1.2):
+        command = wanderer.decide(scan_of_segments(facing_wall), time, (0.25, 0.25, math.pi))
+    assert wanderer.mode == "seek"
+    route = wanderer._route
+    assert route[-1, 0] > 1.0 and np.all((route[:, 1] > -0.5) & (route[:, 1] < 1.0))  # along the corridor to +x
+    assert command[2] != 0.0  # turning round towards it
