@@ -6,10 +6,11 @@ rear corners through it), each with a safety allowance that grows with the odome
 it was seen; (2) picks a desired heading: *explore* heads for the open direction with the most space the
 robot has not yet passed near (a coarse :class:`VisitMap` of the odometry frame, forgotten after a while so
 that wandering never ends); when none is in view it *seeks*: follows the shortest route through the free
-space its laser has shown it (:class:`SeenSpace`) to the nearest place not yet visited, such as a room glimpsed
-through a door; with none left a *tour* takes the open direction nearest round to one side (a left- or
-right-hand rule: through every door and round every room), the side redrawn by a seeded generator; (3) picks, from a fixed set of velocity commands, the one that best serves that heading while the
-body, simulated along the command's arc, keeps clear of every point (a dynamic-window check). No command is
+space its laser has shown it (:class:`SeenSpace`) to the nearest place not yet visited, such as a room
+glimpsed through a door; with none left a *tour* takes the open direction nearest round to one side (a left-
+or right-hand rule: through every door and round every room), the side redrawn by a seeded generator; (3)
+picks, from a fixed set of velocity commands, the one that best serves that heading while the body, simulated
+along the command's arc, keeps clear of every point (:class:`ArcPlanner`, a dynamic-window check). No command is
 ever zero, and none brings the body closer to a point than ``safety_distance`` (or than it already is), so it
 never drives into what it has seen. Dithering in place (no net motion for half a second) is broken by turning
 one way only, then by backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot
@@ -25,26 +26,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stage_sim.core.arc_planner import MAX_ALLOWANCE, TOLERANCE, ArcPlanner
 from stage_sim.core.doorways import DoorPassage, Doorway, find_doorways
 from stage_sim.core.laser_reading import LaserReading, wrap
 from stage_sim.core.seen_space import SeenSpace, route_heading
-from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
+from stage_sim.core.velocity_arcs import arc_poses
 from stage_sim.core.visit_map import VisitMap
 
-# Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
-CHECK_TIMES = np.array([0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.1, 1.5])
-SAFE_TIMES = np.concatenate([[0.0], CHECK_TIMES[:-1]])  # how long an arc stays clear if it hits at index k
-TURN_CHECK = 4  # index in CHECK_TIMES of the pose (0.6 s) whose turning circle should be clear
-ADMISSIBLE_S = 0.4  # an arc must stay clear this long to be chosen when any does
-LOOK_AHEAD_S = 1.0  # heading and progress of a candidate are judged at this time
-TOLERANCE = 0.005  # m a point already inside the safety distance may come closer (sensor quantisation)
 MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
-CLEARANCE_CAP = 0.15  # m of clearance beyond which more is no better
-CLEARANCE_WEIGHT = 2.5  # worth of that clearance against heading and progress (about 1 each)
-PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
 ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net turn (m/m, rad/rad) since a point was seen
 MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free space for a point to be moving
-MAX_ALLOWANCE = 0.1  # m: remembered points less certain than this are forgotten
 OPEN_RANGE = 1.5  # m of free corridor ahead for an escape direction to count as open
 BLOCKED_RANGE = 0.7  # m of free corridor below which an explore heading is abandoned
 TOUR_RANGE = 1.0  # m of free corridor for a direction to count as open to the tour
@@ -120,22 +111,13 @@ class Wanderer:
     def __init__(self, config: WanderConfig | None = None, seed: int | None = None) -> None:
         self.config = config or WanderConfig()
         self.rng = np.random.default_rng(seed)
-        self.commands = candidate_commands(self.config)
-        self._poses = arc_poses(self.commands, CHECK_TIMES)
-        self._look = arc_poses(self.commands, np.array([LOOK_AHEAD_S]))[:, 0]
-        boxes = np.array(self.config.footprint, dtype=np.float64).reshape(-1, 4)
-        self._boxes = boxes
+        self.planner = ArcPlanner(self.config)
+        boxes = self.planner.boxes
         self._front = float(boxes[:, 1].max())
         self._half_width = float(np.abs(boxes[:, 2:]).max())
         x_min, x_max, y_min, y_max = boxes[0]  # the chassis, sampled finely enough to touch every cell under it
         grid = np.meshgrid(np.linspace(x_min, x_max, 6), np.linspace(y_min, y_max, 5))
         self._body_points = np.stack([grid[0].ravel(), grid[1].ravel()], axis=-1)
-        self._radius = float(np.hypot(np.abs(boxes[:, :2]).max(axis=1), np.abs(boxes[:, 2:]).max(axis=1)).max())
-        # Candidates grouped by linear speed, with how far from the centre a point can matter to them.
-        speeds = np.round(np.hypot(self.commands[:, 0], self.commands[:, 1]), 6)
-        margin = self.config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
-        self._groups = [(v * CHECK_TIMES[-1] + self._radius + margin, np.flatnonzero(speeds == v))
-                        for v in np.unique(speeds)]
         self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
         self._last_scan: tuple | None = None  # the previous scan: laser pose (odometry frame) and ranges
         self._odometry = np.zeros(2)  # metres driven and net radians turned so far (odometry errors scale with these)
@@ -362,7 +344,7 @@ class Wanderer:
         """The turn rate that backs the robot along its trail (pure pursuit in reverse), None when the retreat
         is over: RETREAT_MIN back (and, giving up, free to turn round in place), or out of trail."""
         backed = self._backed(pose)
-        turn_free = self._radius + self.config.safety_distance + TOLERANCE
+        turn_free = self.planner.radius + self.config.safety_distance + TOLERANCE
         if backed >= RETREAT_MIN and (not self._retreat_gave_up or np.hypot(
                 points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free):
             return None
@@ -374,7 +356,7 @@ class Wanderer:
         x, y = local[far[0] if len(far) else -1]
         if x >= 0:  # the trail is not behind the robot: it cannot be retraced in reverse
             return None
-        speed = float(self.commands[:, 0].min())
+        speed = float(self.planner.commands[:, 0].min())
         return speed * 2 * y / (x * x + y * y)
 
     def _trail_length(self) -> float:
@@ -413,8 +395,9 @@ class Wanderer:
             self.mode = "explore"
         elif self._seek(time, pose):
             self.mode = "seek"
-        elif self.mode in ("explore", "seek") or time >= self._tour_until or self._side * self._tour_turn >= 2 * math.pi:
-            self.mode, self._tour_turn = "tour", 0.0  # a full turn towards the wall: circling an island
+        elif (self.mode in ("explore", "seek") or time >= self._tour_until
+              or self._side * self._tour_turn >= 2 * math.pi):  # a full turn towards the wall: circling an island
+            self.mode, self._tour_turn = "tour", 0.0
             self._tour_until = time + self.rng.uniform(*self.config.tour_s)
             self._side = float(self.rng.choice((-1.0, 1.0)))
 
@@ -531,75 +514,15 @@ class Wanderer:
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, time: float,
         retreat_turn: float | None = None,
     ) -> tuple[float, ...]:
-        """The best command for ``heading`` among those whose arc keeps the body clear of every point, moving
-        points (other robots) being given room that grows at ``moving_speed`` along the arc; retreating, the
-        reverse command nearest ``retreat_turn`` if any is clear."""
-        config = self.config
-        # How near each point could come within the horizon: moving ones come nearer.
-        distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
-        near = distance < self._groups[-1][0]
-        _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
-        order = thin[np.argsort(distance[near][thin])]
-        points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
-        moving = moving[near][order]
-        now = self._body_distance(points[:, 0], points[:, 1])
+        """The best command for ``heading`` whose arc keeps clear (:class:`ArcPlanner`); a reverse chosen
+        other than in a retreat or a tight spot starts a spell of backing up."""
         retreating = retreat_turn is not None
-        backing = retreating or time < self._backing_until  # getting out of a tight spot: half the margin will do
-        if retreating:  # retracing where the body has just been: no allowance for odometry drift is needed
-            allowance = np.zeros_like(allowance)
-        keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
-                    + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
-        limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
-        closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
-        for reach, rows in self._groups:  # a slow arc only needs the points it can reach
-            count = int(np.searchsorted(distance, reach))
-            if count:
-                x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
-                c, s = np.cos(yaw), np.sin(yaw)
-                dx, dy = points[:count, 0] - x, points[:count, 1] - y
-                margin = self._body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:, :count]
-                closest[rows] = margin.min(axis=2)
-        hit = np.logical_or.accumulate(closest < 0, axis=1)
-        safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
-        clearance = np.where(hit, np.inf, closest).min(axis=1)
-        look_x, look_y, look_yaw = self._look.T
-        progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
-        speed = self.commands[:, 0]
-        door = self.mode == "door"  # a narrow door leaves little clearance and no room to turn: ask for less
-        score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
-                 + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
-                 - 0.2 * np.abs(self.commands[:, 2] - self.command[2]) / config.turn_rate
-                 - (1.0 if door else 8.0) * self._cramped(points)
-                 - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
-                 - 3.0 * ((time < self._commit[0]) & (self.commands[:, 2] * self._commit[1] < 0)))
-        # Backing up is only safe over ground just driven forward: the laser does not see behind.
-        room = self._trail_length() if retreating else self._reverse_room
-        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= room)
-        admissible = (safe_until >= ADMISSIBLE_S) & reversible
-        if retreating and (admissible & (speed < 0)).any():
-            admissible &= speed < 0
-            score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
-        if not admissible.any():  # nothing stays clear long enough: of what may be done, whatever stays clear
-            longest = np.where(reversible, safe_until, -1.0)  # longest, then with least intrusion in its first step
-            admissible = longest == longest.max()
-            score = closest[:, 0]
-        best = int(np.argmax(np.where(admissible, score, -np.inf)))
-        if speed[best] < 0 and not backing:
+        backing = retreating or time < self._backing_until
+        best = self.planner.choose(
+            points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
+            backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0,
+            reverse_room=self._trail_length() if retreating else self._reverse_room, retreat_turn=retreat_turn)
+        command = self.planner.commands[best]
+        if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
-        return tuple(float(v) for v in self.commands[best])
-
-    def _cramped(self, points: np.ndarray) -> np.ndarray:
-        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
-        x, y = (self._poses[:, TURN_CHECK, k, None] for k in range(2))
-        nearest = np.hypot(points[:, 0] - x, points[:, 1] - y).min(axis=1, initial=np.inf)
-        return np.maximum(self._radius + self.config.safety_distance - nearest, 0.0)
-
-    def _body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Distance from body-frame points to the body (0 inside): the nearest of its rectangles."""
-        distance = None
-        for x_min, x_max, y_min, y_max in self._boxes:
-            dx = np.maximum(np.maximum(x - x_max, x_min - x), 0.0)
-            dy = np.maximum(np.maximum(y - y_max, y_min - y), 0.0)
-            box = np.hypot(dx, dy)
-            distance = box if distance is None else np.minimum(distance, box)
-        return distance
+        return tuple(float(v) for v in command)

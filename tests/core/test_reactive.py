@@ -14,8 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stage_sim.core.arc_planner import ADMISSIBLE_S, CHECK_TIMES
 from stage_sim.core.laser_reading import LaserReading
-from stage_sim.core.reactive import ADMISSIBLE_S, CHECK_TIMES, WanderConfig, Wanderer
+from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.core.run_stats import RunStats
 from stage_sim.core.simulation import Simulation
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands

@@ -52,6 +52,14 @@ def test_a_beam_that_reached_its_limit_frees_its_end_cell_too() -> None:
     assert score_at(space, 1.05, 0.05) < 0
 
 
+def test_where_the_body_stands_counts_as_free() -> None:
+    space = SeenSpace(cell=0.1, extent=20.0)
+    body = np.array([[x, y] for x in (-0.15, -0.05, 0.05, 0.15) for y in (-0.05, 0.05)])
+    space.observe(np.array([0.25, 0.05]), np.array([[1.25, 0.05]]), np.array([True]), body)
+    assert all(score_at(space, x, y) < 0 for x, y in body)
+    assert score_at(space, -0.25, 0.05) == 0
+
+
 def test_later_scans_outweigh_a_misplaced_wall() -> None:
     space = SeenSpace(cell=0.1, extent=20.0)
     wall = (np.array([0.05, 0.05]), np.array([[1.05, 0.05]]), np.array([True]))
