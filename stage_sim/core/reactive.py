@@ -1,21 +1,20 @@
 """Reactive wandering for a laser-equipped mobile robot: the decision logic of the ``wander`` node, ROS-free.
 
-Per scan, :class:`Wanderer` (1) turns the scan into obstacle points and keeps, in the odometry frame, the
-nearby points that have left the laser's field of view (the rear is blind, yet turning in place swings the
-rear corners through it), each with a safety allowance that grows with the odometry error accumulated since
-it was seen; (2) picks a desired heading: *explore* heads for the open direction with the most space the
-robot has not yet passed near (a coarse :class:`VisitMap` of the odometry frame, forgotten after a while so
-that wandering never ends); when none is in view it *seeks*: follows the shortest route through the free
-space its laser has shown it (:class:`SeenSpace`) to the nearest place not yet visited, such as a room
-glimpsed through a door; with none left a *tour* takes the open direction nearest round to one side (a left-
-or right-hand rule: through every door and round every room), the side redrawn by a seeded generator; (3)
-picks, from a fixed set of velocity commands, the one that best serves that heading while the body, simulated
-along the command's arc, keeps clear of every point (:class:`ArcPlanner`, a dynamic-window check). No command is
-ever zero, and none brings the body closer to a point than ``safety_distance`` (or than it already is), so it
-never drives into what it has seen. Dithering in place (no net motion for half a second) is broken by turning
-one way only, then by backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot
-gives up what lay ahead and retraces in reverse the path it last drove forward, the only ground behind it
-known to be clear, until it can turn round.
+Per scan, :class:`Wanderer` (1) turns the scan into obstacle points and keeps the nearby ones that have left
+the laser's field of view, with a safety allowance for odometry drift (:class:`ObstacleMemory`); (2) picks a
+desired heading: *explore* heads for the open direction with the most space the robot has not yet passed near
+(a coarse :class:`VisitMap` of the odometry frame, forgotten after a while so that wandering never ends); when
+none is in view it *seeks*: follows the shortest route through the free space its laser has shown it
+(:class:`SeenSpace`) to the nearest place not yet visited, such as a room glimpsed through a door; with none
+left a *tour* takes the open direction nearest round to one side (a left- or right-hand rule: through every
+door and round every room), the side redrawn by a seeded generator; (3) picks, from a fixed set of velocity
+commands, the one that best serves that heading while the body, simulated along the command's arc, keeps
+clear of every point (:class:`ArcPlanner`, a dynamic-window check). No command is ever zero, and none brings
+the body closer to a point than ``safety_distance`` (or than it already is), so it never drives into what it
+has seen. Dithering in place (no net motion for half a second) is broken by turning one way only, then by
+backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot gives up what lay
+ahead and retraces in reverse the path it last drove forward, the only ground behind it known to be clear,
+until it can turn round.
 """
 
 from __future__ import annotations
@@ -26,16 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stage_sim.core.arc_planner import MAX_ALLOWANCE, TOLERANCE, ArcPlanner
+from stage_sim.core.arc_planner import TOLERANCE, ArcPlanner
 from stage_sim.core.doorways import DoorPassage, Doorway, find_doorways
 from stage_sim.core.laser_reading import LaserReading, wrap
+from stage_sim.core.obstacle_memory import ObstacleMemory, compose
 from stage_sim.core.seen_space import SeenSpace, route_heading
 from stage_sim.core.velocity_arcs import arc_poses
 from stage_sim.core.visit_map import VisitMap
 
-MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
-ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net turn (m/m, rad/rad) since a point was seen
-MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free space for a point to be moving
 OPEN_RANGE = 1.5  # m of free corridor ahead for an escape direction to count as open
 BLOCKED_RANGE = 0.7  # m of free corridor below which an explore heading is abandoned
 TOUR_RANGE = 1.0  # m of free corridor for a direction to count as open to the tour
@@ -89,15 +86,6 @@ class WanderConfig:
     visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
 
 
-def _compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool = False) -> np.ndarray:
-    """Points (P, 2) given in the frame at ``pose`` in the outer frame, or the reverse with ``inverse``."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    if inverse:
-        dx, dy = points[:, 0] - pose[0], points[:, 1] - pose[1]
-        return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
-    return np.stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]], -1)
-
-
 def _near_route(points: np.ndarray, route: np.ndarray | None) -> bool:
     """Whether any of the points (P, 2) lies within half a metre of the route."""
     if route is None:
@@ -118,8 +106,7 @@ class Wanderer:
         x_min, x_max, y_min, y_max = boxes[0]  # the chassis, sampled finely enough to touch every cell under it
         grid = np.meshgrid(np.linspace(x_min, x_max, 6), np.linspace(y_min, y_max, 5))
         self._body_points = np.stack([grid[0].ravel(), grid[1].ravel()], axis=-1)
-        self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
-        self._last_scan: tuple | None = None  # the previous scan: laser pose (odometry frame) and ranges
+        self.obstacles = ObstacleMemory(self.config.memory_radius)
         self._odometry = np.zeros(2)  # metres driven and net radians turned so far (odometry errors scale with these)
         self._pose: tuple[float, float, float] | None = None
         self._time = 0.0
@@ -166,7 +153,7 @@ class Wanderer:
             self._tour_turn += turn
             self._extend_trail(pose, forward)
         self._pose, self._time = pose, time
-        points, allowance, moving = self._observe(reading, pose)
+        points, allowance, moving = self.obstacles.update(reading, pose, self._odometry)
         self.visits.stamp(pose[0], pose[1], time)
         self._see(reading, pose)
         if self._stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
@@ -204,30 +191,8 @@ class Wanderer:
         if self._pose is None:
             return (0.0, 0.0, 0.0)
         step = arc_poses(np.array([self.command]), np.array([max(0.0, time - self._time)]))[0, 0]
-        x, y = _compose(self._pose, step[None, :2])[0]
+        x, y = compose(self._pose, step[None, :2])[0]
         return (float(x), float(y), float(wrap(self._pose[2] + step[2])))
-
-    def _observe(self, reading: LaserReading, pose: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Obstacle points in the robot frame (this scan, then remembered ones out of view), their allowances,
-        and which of them are moving (nearer than the last scan put anything along their beam)."""
-        seen, beams = reading.points(), reading.hits()
-        moving = self._approaching(reading, pose)[beams]
-        remembered = _compose(pose, self._memory[:, :2], inverse=True)
-        keep = reading.outside_view(remembered)
-        points = np.concatenate([seen, remembered[keep]])
-        stamps = np.concatenate([np.tile(self._odometry, (len(seen), 1)), self._memory[keep, 2:]])
-        distance = np.hypot(points[:, 0], points[:, 1])
-        drift = np.abs(self._odometry - stamps) * ODOM_DRIFT
-        allowance = drift[:, 0] + drift[:, 1] * distance
-        trusted = allowance <= MAX_ALLOWANCE
-        moving = np.concatenate([moving, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
-        points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
-        near = distance < self.config.memory_radius
-        world = _compose(pose, points[near])
-        _, unique = np.unique(np.floor(world / MEMORY_CELL).astype(np.int64), axis=0, return_index=True)
-        unique.sort()  # the first of a cell is the freshest
-        self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
-        return points, allowance, moving
 
     def _see(self, reading: LaserReading, pose: tuple) -> None:
         """Add the scan to the map of seen space: beams that hit or reached their range limit (NaN and
@@ -235,34 +200,9 @@ class Wanderer:
         ranges = np.asarray(reading.ranges, dtype=np.float64)
         hit = reading.hits()
         valid = hit | (ranges >= reading.range_max)  # includes +inf
-        ends = _compose(pose, reading.beam_ends(np.where(hit, ranges, reading.range_max))[valid])
-        origin = _compose(pose, np.array([reading.laser_pose[:2]]))[0]
-        self.seen.observe(origin, ends, hit[valid], _compose(pose, self._body_points))
-
-    def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
-        """Per beam: whether it hits something where the previous scan saw free space (its beam, or a
-        neighbour, reached further), i.e. something that moved in, such as another robot."""
-        ranges = np.asarray(reading.ranges, dtype=np.float64)
-        x, y, yaw = reading.laser_pose
-        here = (pose[0] + math.cos(pose[2]) * x - math.sin(pose[2]) * y,
-                pose[1] + math.sin(pose[2]) * x + math.cos(pose[2]) * y, pose[2] + yaw)
-        previous, self._last_scan = self._last_scan, (here, np.where(reading.hits(), ranges, reading.range_max))
-        if previous is None:
-            return np.zeros(len(ranges), dtype=bool)
-        (px, py, pyaw), before = previous
-        angles = here[2] + reading.angle_min + np.arange(len(ranges)) * reading.angle_increment
-        end = np.stack([here[0] + ranges * np.cos(angles), here[1] + ranges * np.sin(angles)], axis=-1)
-        seen_from = _compose((px, py, pyaw), end, inverse=True)  # the hit points in the previous laser frame
-        distance = np.hypot(seen_from[:, 0], seen_from[:, 1])
-        index = np.rint((np.arctan2(seen_from[:, 1], seen_from[:, 0]) - reading.angle_min)
-                        / reading.angle_increment).astype(np.int64)
-        padded = np.concatenate([[np.inf], before, [np.inf]])
-        inside = (index >= 0) & (index < len(before))
-        index = np.clip(index, 0, len(before) - 1) + 1
-        free_to = np.minimum(np.minimum(padded[index - 1], padded[index]), padded[index + 1])
-        nearer = inside & reading.hits() & (distance < free_to - (MOVED + MOVED_PER_M * distance))
-        nearer = np.concatenate([[False], nearer, [False]])
-        return nearer[1:-1] & (nearer[:-2] | nearer[2:])  # a lone beam is an edge effect, not a body
+        ends = compose(pose, reading.beam_ends(np.where(hit, ranges, reading.range_max))[valid])
+        origin = compose(pose, np.array([reading.laser_pose[:2]]))[0]
+        self.seen.observe(origin, ends, hit[valid], compose(pose, self._body_points))
 
     def _stuck(self, time: float, pose: tuple[float, float, float]) -> bool:
         """True when the robot has not got 0.5 m away from where it was STUCK_WINDOW_S ago."""
@@ -351,7 +291,7 @@ class Wanderer:
         trail = np.array(self._trail).reshape(-1, 2)[::-1]  # newest first
         if not len(trail):
             return None
-        local = _compose(pose, trail, inverse=True)
+        local = compose(pose, trail, inverse=True)
         far = np.flatnonzero(np.hypot(local[:, 0], local[:, 1]) >= RETREAT_LOOK)
         x, y = local[far[0] if len(far) else -1]
         if x >= 0:  # the trail is not behind the robot: it cannot be retraced in reverse
@@ -456,7 +396,7 @@ class Wanderer:
         with nearer space weighing more (so that the robot takes the door it passes before far corridors)."""
         reach = self._free_distance(points, BEARINGS) + self._front + 0.5
         x, y = SAMPLES * np.cos(BEARINGS)[:, None], SAMPLES * np.sin(BEARINGS)[:, None]
-        world = _compose(pose, np.stack([x.ravel(), y.ravel()], axis=-1)).reshape(*x.shape, 2)
+        world = compose(pose, np.stack([x.ravel(), y.ravel()], axis=-1)).reshape(*x.shape, 2)
         new = ~self.visits.visited_since(world, time - self.config.visit_memory_s) & (reach[:, None] >= SAMPLES)
         step = SAMPLES[1] - SAMPLES[0]
         return new.sum(axis=1) * step, (new * np.exp((SAMPLES[0] - SAMPLES) / NEARNESS)).sum(axis=1) * step
