@@ -20,7 +20,6 @@ until it can turn round.
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +27,7 @@ import numpy as np
 from stage_sim.core.arc_planner import TOLERANCE, ArcPlanner
 from stage_sim.core.doorways import DoorPassage, Doorway, find_doorways
 from stage_sim.core.laser_reading import LaserReading, wrap
+from stage_sim.core.motion_history import TRAIL_STEP, MotionHistory
 from stage_sim.core.obstacle_memory import ObstacleMemory, compose
 from stage_sim.core.seen_space import SeenSpace, route_heading
 from stage_sim.core.velocity_arcs import arc_poses
@@ -44,7 +44,6 @@ NEW_SPACE = 2.0  # m of unvisited space in a direction that makes it worth explo
 NEARNESS = 3.0  # m over which the weight of unvisited space falls by e when choosing where to explore
 LOOK_S = 0.5  # s between looks for new space
 GIVE_UP_RADIUS = 2.0  # m around a stuck spot whose new space is given up on
-STUCK_WINDOW_S = 12.0  # no 0.5 m of progress within this long → escape along a new heading
 ESCAPE_S = 4.0  # s spent heading away from a dead end or a stuck spot
 BACKING_S = 1.0  # s a reverse manoeuvre is kept up before driving forward again
 DOOR_S = 30.0  # s to get through a narrow doorway before giving it up
@@ -53,13 +52,7 @@ DOOR_THROUGH = 0.3  # m past a doorway at which the body is through it (its pass
 DOOR_BEYOND = np.array([1.0, 2.0, 3.0])  # m past a doorway where new space is looked for
 DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was visited this recently
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
-TRAIL_STEP = 0.05  # m between the remembered positions of the path driven forward, which a retreat retraces
-TRAIL_LENGTH = 1.5  # m of that path kept: enough to back out of a dead end the body cannot turn in
-STILL_S = 0.5  # s of going nowhere: within STILL_MOVE m, turning to and fro by at most STILL_TURN rad in all
-STILL_MOVE, STILL_TURN, STILL_NET = 0.05, 0.25, 0.05  # net turn below STILL_NET rad: dithering, not a slow turn
 RETREAT_S = 12.0  # s a retreat may last
-RETREAT_MIN = 0.3  # m a retreat backs up before it may end (where the body can turn round)
-RETREAT_LOOK = 0.3  # m back along the trail of the point a retreat steers for
 COMMIT_S = 2.0  # s of turning one way only when dithering and unable to back out
 ROUTE_S = 3.0  # s a route to far new space is followed before it is planned afresh
 ROUTE_AHEAD = 1.0  # m along the route of the point a seeking robot heads for
@@ -131,13 +124,10 @@ class Wanderer:
         self._escape_until = -math.inf
         self._backing_until = -math.inf
         self._reverse_room = 0.0  # m the robot may back up: along the path it came, never into unseen space
-        self._trail: deque[tuple[float, float]] = deque(maxlen=round(TRAIL_LENGTH / TRAIL_STEP) + 1)
-        self._recent: deque[tuple[float, float, float, float]] = deque()  # (time, x, y, net turn) over STILL_S
+        self.history = MotionHistory()
         self._retreat_until = -math.inf  # backing out along the trail until then (or until free to turn)
-        self._retreat_from = (0.0, 0.0)
         self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
         self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
-        self._progress: list[tuple[float, float, float]] = []  # (time, x, y) about once a second
 
     def decide(
         self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
@@ -151,14 +141,14 @@ class Wanderer:
                 pose[1] - self._pose[1])
             self._reverse_room = min(max(self._reverse_room + forward, 0.0), REVERSE_ROOM_MAX)
             self._tour_turn += turn
-            self._extend_trail(pose, forward)
+            self.history.extend_trail(pose, forward)
         self._pose, self._time = pose, time
         points, allowance, moving = self.obstacles.update(reading, pose, self._odometry)
         self.visits.stamp(pose[0], pose[1], time)
         self._see(reading, pose)
-        if self._stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
+        if self.history.stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
             self._retreat(time, pose, give_up=True)
-        elif self._standing_still(time, pose):
+        elif self.history.standing_still(time, pose, float(self._odometry[1]), time < self._retreat_until):
             if self._door is not None and self._door.progress(pose)[0] > DOOR_THROUGH:
                 self._leave_door(time, given_up=False)  # through, yet not out along the axis: carry on from here
             elif time < self._commit[0]:  # turning one way did not get it going either: back off a little
@@ -204,44 +194,6 @@ class Wanderer:
         origin = compose(pose, np.array([reading.laser_pose[:2]]))[0]
         self.seen.observe(origin, ends, hit[valid], compose(pose, self._body_points))
 
-    def _stuck(self, time: float, pose: tuple[float, float, float]) -> bool:
-        """True when the robot has not got 0.5 m away from where it was STUCK_WINDOW_S ago."""
-        if not self._progress or time - self._progress[-1][0] >= 1.0:
-            self._progress.append((time, pose[0], pose[1]))
-        while len(self._progress) > 1 and time - self._progress[1][0] >= STUCK_WINDOW_S:
-            self._progress.pop(0)
-        old_time, x, y = self._progress[0]
-        if time - old_time >= STUCK_WINDOW_S and math.hypot(pose[0] - x, pose[1] - y) < 0.5:
-            self._progress = [(time, pose[0], pose[1])]
-            return True
-        return False
-
-    def _standing_still(self, time: float, pose: tuple[float, float, float]) -> bool:
-        """True when for STILL_S the robot has got nowhere: dithering between small turns or creeping to and
-        fro (never while retreating)."""
-        recent = self._recent
-        recent.append((time, pose[0], pose[1], float(self._odometry[1])))
-        while time - recent[0][0] > STILL_S + 1e-6:
-            recent.popleft()
-        if time < self._retreat_until or time - recent[0][0] < STILL_S - 1e-6:
-            return False
-        history = np.array(recent)
-        moved = np.hypot(history[:, 1] - pose[0], history[:, 2] - pose[1]).max()
-        turns = history[:, 3]
-        still = moved < STILL_MOVE and np.ptp(turns) < STILL_TURN and abs(turns[-1] - turns[0]) < STILL_NET
-        if still:
-            recent.clear()
-        return bool(still)
-
-    def _extend_trail(self, pose: tuple[float, float, float], forward: float) -> None:
-        """Remember the path driven forward (every TRAIL_STEP); backing up along it uses it up."""
-        trail = self._trail
-        if forward > 0 and (not trail or math.hypot(pose[0] - trail[-1][0], pose[1] - trail[-1][1]) >= TRAIL_STEP):
-            trail.append((pose[0], pose[1]))
-        elif forward < 0:
-            while trail and math.hypot(pose[0] - trail[-1][0], pose[1] - trail[-1][1]) < TRAIL_STEP:
-                trail.pop()
-
     def _retreat(self, time: float, pose: tuple[float, float, float], give_up: bool) -> None:
         """Start backing out along the trail; giving up, what lay ahead counts as visited so it is not tried
         again at once, and the retreat goes on until the robot can turn round."""
@@ -250,61 +202,33 @@ class Wanderer:
                 self._leave_door(time, given_up=True)
             self.visits.mark(np.array(pose[:2]) + self._give_up_disc, time)
         self._retreat_gave_up = give_up
-        self._recent.clear()
         self._retreat_until = time + RETREAT_S
-        self._retreat_from = (pose[0], pose[1])
+        self.history.start_retreat(pose)
 
     def _commit_turn(self, time: float) -> None:
         """Turn only the way the robot is turning now, for COMMIT_S (dithering between the two ends nowhere)."""
         self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
-
-    def _backed(self, pose: tuple) -> float:
-        """Metres from where the current retreat began."""
-        return math.hypot(pose[0] - self._retreat_from[0], pose[1] - self._retreat_from[1])
 
     def _retreat_command(
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, pose: tuple, time: float
     ) -> tuple[float, ...] | None:
         """The next reverse command of the retreat; None once it is over (then, giving up, escape somewhere
         open; with no way back at all, turn one way only for a while)."""
-        steer = self._retreat_turn(points, pose)
+        turn_free = self.planner.radius + self.config.safety_distance + TOLERANCE
+        free_to_turn = np.hypot(points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free
+        speed = float(self.planner.commands[:, 0].min())
+        steer = self.history.retreat_turn(pose, speed, free_to_turn, until_free=self._retreat_gave_up)
         if steer is not None:
             command = self._plan(points, allowance, moving, math.pi, time, retreat_turn=steer)
             if command[0] < 0:
                 return command
         self._retreat_until = -math.inf
-        self._recent.clear()  # standing still is judged afresh from here
-        if self._backed(pose) < TRAIL_STEP:
+        self.history.forget_recent()  # standing still is judged afresh from here
+        if self.history.backed(pose) < TRAIL_STEP:
             self._commit_turn(time)
         if self._retreat_gave_up:
             self._escape(time, self._pick_heading(points, pose))
         return None
-
-    def _retreat_turn(self, points: np.ndarray, pose: tuple) -> float | None:
-        """The turn rate that backs the robot along its trail (pure pursuit in reverse), None when the retreat
-        is over: RETREAT_MIN back (and, giving up, free to turn round in place), or out of trail."""
-        backed = self._backed(pose)
-        turn_free = self.planner.radius + self.config.safety_distance + TOLERANCE
-        if backed >= RETREAT_MIN and (not self._retreat_gave_up or np.hypot(
-                points[:, 0], points[:, 1]).min(initial=np.inf) > turn_free):
-            return None
-        trail = np.array(self._trail).reshape(-1, 2)[::-1]  # newest first
-        if not len(trail):
-            return None
-        local = compose(pose, trail, inverse=True)
-        far = np.flatnonzero(np.hypot(local[:, 0], local[:, 1]) >= RETREAT_LOOK)
-        x, y = local[far[0] if len(far) else -1]
-        if x >= 0:  # the trail is not behind the robot: it cannot be retraced in reverse
-            return None
-        speed = float(self.planner.commands[:, 0].min())
-        return speed * 2 * y / (x * x + y * y)
-
-    def _trail_length(self) -> float:
-        """Metres of remembered path behind the robot (the room a retreat has)."""
-        if not self._trail or self._pose is None:
-            return 0.0
-        path = np.array([self._pose[:2], *reversed(self._trail)])
-        return float(np.hypot(*np.diff(path, axis=0).T).sum())
 
     # -- behaviours -------------------------------------------------------------------------------
 
@@ -458,10 +382,11 @@ class Wanderer:
         other than in a retreat or a tight spot starts a spell of backing up."""
         retreating = retreat_turn is not None
         backing = retreating or time < self._backing_until
+        room = self.history.trail_length(self._pose) if retreating else self._reverse_room
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
-            backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0,
-            reverse_room=self._trail_length() if retreating else self._reverse_room, retreat_turn=retreat_turn)
+            backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,
+            retreat_turn=retreat_turn)
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
