@@ -60,6 +60,7 @@ ROUTE_OFF = 1.0  # m off its route at which a seeking robot plans a new one
 ROUTE_SPEED = 0.25  # m/s at least along a route: slower, its goal is given up (marked visited)
 ROUTE_SLACK_S = 30.0  # s allowed on top of that for doors and other robots
 GOAL_RADIUS = 1.0  # m around a goal given up on that counts as visited
+DOOR_ROUTE_GAP = 0.3  # m off a doorway's axis within which a route through it passes
 
 
 @dataclass(frozen=True)
@@ -79,11 +80,15 @@ class WanderConfig:
     visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
 
 
-def _near_route(points: np.ndarray, route: np.ndarray | None) -> bool:
-    """Whether any of the points (P, 2) lies within half a metre of the route."""
+def _route_through(passage: DoorPassage, route: np.ndarray | None) -> bool:
+    """Whether the route crosses the doorway: it runs through the door's opening from one side to the other."""
     if route is None:
         return False
-    return bool((np.hypot(points[:, None, 0] - route[:, 0], points[:, None, 1] - route[:, 1]) < 0.5).any())
+    offset = route - passage.center
+    along = offset @ passage.normal
+    lateral = np.abs(offset @ np.array([-passage.normal[1], passage.normal[0]]))
+    close = (lateral < DOOR_ROUTE_GAP) & (np.abs(along) < 1.0)
+    return bool((close & (along < -0.1)).any() and (close & (along > 0.1)).any())
 
 
 class Wanderer:
@@ -296,7 +301,7 @@ class Wanderer:
         since = time - (DOOR_RECENT_S if self.mode == "tour" else self.config.visit_memory_s)
         passages = [DoorPassage.seen_from(doorway, pose, time + DOOR_S) for doorway in self._doorways(reading)]
         fresh = [p for p in passages if (~self.visits.visited_since(p.beyond(DOOR_BEYOND), since)).sum() >= 2
-                 or (self.mode == "seek" and _near_route(p.beyond(DOOR_BEYOND[:1]), self._route))]
+                 or (self.mode == "seek" and _route_through(p, self._route))]
         return min(fresh, key=lambda p: -p.progress(pose)[0], default=None)
 
     def _door_heading(self, reading: LaserReading, pose: tuple, time: float) -> float | None:

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 from stage_sim.core.arc_planner import ADMISSIBLE_S, CHECK_TIMES
+from stage_sim.core.doorways import DoorPassage
 from stage_sim.core.laser_reading import LaserReading
-from stage_sim.core.reactive import WanderConfig, Wanderer
+from stage_sim.core.reactive import WanderConfig, Wanderer, _route_through
 from stage_sim.core.run_stats import RunStats
 from stage_sim.core.simulation import Simulation
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
@@ -261,3 +262,14 @@ def test_with_nothing_new_in_view_it_heads_back_for_new_space_it_saw_earlier() -
     route = wanderer._route
     assert route[-1, 0] > 1.0 and np.all((route[:, 1] > -0.5) & (route[:, 1] < 1.0))  # along the corridor to +x
     assert command[2] != 0.0  # turning round towards it
+
+
+def test_a_seeking_robot_takes_a_narrow_door_only_when_its_route_runs_through_it() -> None:
+    door = DoorPassage(np.array([0.0, 0.0]), np.array([1.0, 0.0]), until=10.0)
+    through = np.stack([np.arange(-1.5, 1.51, 0.1), np.full(31, 0.1)], axis=-1)
+    past = np.stack([np.full(31, -0.6), np.arange(-1.5, 1.51, 0.1)], axis=-1)  # along the wall, by the door
+    to_the_door = through[through[:, 0] <= 0.0]
+    assert _route_through(door, through)
+    assert not _route_through(door, past)
+    assert not _route_through(door, to_the_door)
+    assert not _route_through(door, None)
