@@ -120,8 +120,20 @@ class DoorPassage:
 
     def progress(self, pose: tuple[float, float, float]) -> tuple[float, float]:
         """(along, lateral): how far past the door the robot is along the normal, and how far off the axis."""
-        offset = np.array(pose[:2]) - self.center
-        return float(offset @ self.normal), float(offset @ np.array([-self.normal[1], self.normal[0]]))
+        along, lateral = self._in_door_frame(np.array(pose[:2]))
+        return float(along), float(lateral)
+
+    def crossed_by(self, path: np.ndarray, gap: float) -> bool:
+        """Whether the path (P, 2) runs through the opening from one side to the other: within ``gap`` of the
+        axis, from just before the door to just past it."""
+        along, lateral = self._in_door_frame(path)
+        close = (np.abs(lateral) < gap) & (np.abs(along) < 1.0)
+        return bool((close & (along < -0.1)).any() and (close & (along > 0.1)).any())
+
+    def _in_door_frame(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points (..., 2) as (along the normal past the door, off the axis)."""
+        offset = points - self.center
+        return offset @ self.normal, offset @ np.array([-self.normal[1], self.normal[0]])
 
     def heading(self, pose: tuple[float, float, float]) -> float:
         """The heading (odometry frame) that brings the robot onto the axis and through the door."""

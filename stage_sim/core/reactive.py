@@ -80,17 +80,6 @@ class WanderConfig:
     visit_memory_s: float = 3000.0  # s after which a visited place counts as new again
 
 
-def _route_through(passage: DoorPassage, route: np.ndarray | None) -> bool:
-    """Whether the route crosses the doorway: it runs through the door's opening from one side to the other."""
-    if route is None:
-        return False
-    offset = route - passage.center
-    along = offset @ passage.normal
-    lateral = np.abs(offset @ np.array([-passage.normal[1], passage.normal[0]]))
-    close = (lateral < DOOR_ROUTE_GAP) & (np.abs(along) < 1.0)
-    return bool((close & (along < -0.1)).any() and (close & (along > 0.1)).any())
-
-
 class Wanderer:
     """Decides a velocity command per scan; the same seed and inputs give the same commands."""
 
@@ -117,6 +106,7 @@ class Wanderer:
         offsets = np.arange(-GIVE_UP_RADIUS, GIVE_UP_RADIUS + 0.01, self.visits.cell)
         disc = np.stack(np.meshgrid(offsets, offsets), axis=-1).reshape(-1, 2)
         self._give_up_disc = disc[np.hypot(disc[:, 0], disc[:, 1]) <= GIVE_UP_RADIUS]
+        self._goal_disc = disc[np.hypot(disc[:, 0], disc[:, 1]) <= GOAL_RADIUS]
         self.mode = "explore"  # or "seek", "tour", or "door" while passing self._door
         self._door: DoorPassage | None = None
         self._door_widths = (2 * (self._half_width + self.config.safety_distance) + 0.02,
@@ -288,7 +278,7 @@ class Wanderer:
         if self._goal is None or np.hypot(*(route[-1] - self._goal[0])) > GOAL_RADIUS:  # a new goal
             self._goal = (route[-1], time + length / ROUTE_SPEED + ROUTE_SLACK_S)
         elif time > self._goal[1]:  # the same goal for too long: it cannot be reached from here
-            self.visits.mark(route[-1] + self._give_up_disc[np.hypot(*self._give_up_disc.T) <= GOAL_RADIUS], time)
+            self.visits.mark(route[-1] + self._goal_disc, time)
             self._route = None
             return False
         return True
@@ -301,7 +291,7 @@ class Wanderer:
         since = time - (DOOR_RECENT_S if self.mode == "tour" else self.config.visit_memory_s)
         passages = [DoorPassage.seen_from(doorway, pose, time + DOOR_S) for doorway in self._doorways(reading)]
         fresh = [p for p in passages if (~self.visits.visited_since(p.beyond(DOOR_BEYOND), since)).sum() >= 2
-                 or (self.mode == "seek" and _route_through(p, self._route))]
+                 or (self.mode == "seek" and self._route is not None and p.crossed_by(self._route, DOOR_ROUTE_GAP))]
         return min(fresh, key=lambda p: -p.progress(pose)[0], default=None)
 
     def _door_heading(self, reading: LaserReading, pose: tuple, time: float) -> float | None:

@@ -16,6 +16,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from stage_sim.core.laser_reading import wrap
+
 HIT, PASS, CLIP = 3, -1, 6  # score a cell gains when a beam ends in it, loses when one crosses it; bound
 SAMPLE_STEP = 0.1  # m between the points along a beam that mark cells free
 WANTED_BLOCK = 5  # cells: a place is wanted if enough wanted cells lie in the block of this side around it
@@ -134,5 +136,4 @@ def route_heading(route: np.ndarray, pose: tuple[float, float, float], ahead: fl
     nearest = int(np.argmin(gaps))
     along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route, axis=0).T))])
     target = route[min(int(np.searchsorted(along, along[nearest] + ahead)), len(route) - 1)]
-    heading = math.atan2(target[1] - pose[1], target[0] - pose[0]) - pose[2]
-    return (heading + math.pi) % (2 * math.pi) - math.pi, float(gaps[nearest])
+    return float(wrap(math.atan2(target[1] - pose[1], target[0] - pose[0]) - pose[2])), float(gaps[nearest])

@@ -17,7 +17,7 @@ import pytest
 from stage_sim.core.arc_planner import ADMISSIBLE_S, CHECK_TIMES
 from stage_sim.core.doorways import DoorPassage
 from stage_sim.core.laser_reading import LaserReading
-from stage_sim.core.reactive import WanderConfig, Wanderer, _route_through
+from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.core.run_stats import RunStats
 from stage_sim.core.simulation import Simulation
 from stage_sim.core.velocity_arcs import arc_poses, candidate_commands
@@ -269,7 +269,6 @@ def test_a_seeking_robot_takes_a_narrow_door_only_when_its_route_runs_through_it
     through = np.stack([np.arange(-1.5, 1.51, 0.1), np.full(31, 0.1)], axis=-1)
     past = np.stack([np.full(31, -0.6), np.arange(-1.5, 1.51, 0.1)], axis=-1)  # along the wall, by the door
     to_the_door = through[through[:, 0] <= 0.0]
-    assert _route_through(door, through)
-    assert not _route_through(door, past)
-    assert not _route_through(door, to_the_door)
-    assert not _route_through(door, None)
+    assert door.crossed_by(through, 0.3)
+    assert not door.crossed_by(past, 0.3)
+    assert not door.crossed_by(to_the_door, 0.3)
