@@ -1,4 +1,4 @@
-"""Benchmark of :mod:`stage_sim.core.raycast` against a per-ray Amanatides–Woo traversal in numba.
+"""Benchmark of :mod:`stage_sim.sensing.raycast` against a per-ray Amanatides–Woo traversal in numba.
 
 Run with the project's venv python: ``PYTHONPATH=. .venv/bin/python benchmarks/raycast.py``.
 Prints one JSON object per line. numba is used here only, as the reference.
@@ -19,9 +19,9 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 import numba
 import numpy as np
 
-from stage_sim.core.polygon_raster import outline_points, point_cells
-from stage_sim.core.raycast import GridRayCaster
-from stage_sim.core.robot_layer import RobotLayer
+from stage_sim.maps.polygon_raster import outline_points, point_cells
+from stage_sim.sensing.raycast import GridRayCaster
+from stage_sim.sensing.robot_layer import RobotLayer
 
 RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
 MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/
@@ -192,7 +192,7 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
     points = centres[:, None, :] + np.einsum("rij,pj->rpi", rot, outline)
     point_ids = np.repeat(np.arange(robots), len(outline))
     owners = np.repeat(np.arange(robots), beams)
-    layer = RobotLayer(caster)
+    layer = RobotLayer(caster.windows, caster.resolution, caster.origin_xy)
 
     def footprints():
         flat = point_cells(points, RESOLUTION, (0.0, 0.0), occ.shape).ravel()

@@ -23,8 +23,8 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from stage_sim.core.simulation import Simulation  # noqa: E402
-from stage_sim.core.world_loader import load_world_text  # noqa: E402
+from stage_sim.sim.simulation import Simulation  # noqa: E402
+from stage_sim.worldfile.loader import load_world_text  # noqa: E402
 
 WORLD = """
 resolution 0.02

@@ -18,12 +18,12 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
-from stage_sim.core.errors import WorldError
 from stage_sim.ros.interrupts import sigterm_interrupts
 from stage_sim.ros.recording import recording
 from stage_sim.ros.session import parse_args
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.teleop import KeyReader, TeleopTwistKeyboard
+from stage_sim.worldfile.errors import WorldError
 
 
 def main(argv: list[str]) -> int:

@@ -1,6 +1,51 @@
 """stage_sim: a pure-Python re-implementation of Stage's stageros for ROS 2.
 
-The simulation core (:mod:`stage_sim.core`) runs without ROS; :mod:`stage_sim.ros` holds the rclpy nodes.
+Dependencies point one way only, top to bottom (enforced by import-linter, ``.importlinter``)::
+
+    cli | ros                                   entry points; only ros imports rclpy
+    runs | rendering                            uses of a running simulation
+    wander                                      the reactive controller (never imports sim)
+    sim                                         Simulation: robots, kinematics, odometry, collision
+    sensing                                     exact ray casting on the grid
+    maps                                        the static world rasterised
+    worldfile                                   .world/.inc/bitmap/YAML → WorldDescription
+
+The names below are the public API, imported on first use so that ``import stage_sim`` stays cheap.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
+
+_PUBLIC = {
+    "Simulation": "stage_sim.sim.simulation",
+    "RobotState": "stage_sim.sim.simulation",
+    "Scan": "stage_sim.sim.rangers",
+    "load_world": "stage_sim.worldfile.loader",
+    "load_world_text": "stage_sim.worldfile.loader",
+    "WorldDescription": "stage_sim.worldfile.description",
+    "WorldError": "stage_sim.worldfile.errors",
+    "render": "stage_sim.rendering.frame",
+}
+
+__all__ = [
+    "RobotState", "Scan", "Simulation", "WorldDescription", "WorldError", "load_world", "load_world_text", "render",
+]
+
+if TYPE_CHECKING:
+    from stage_sim.rendering.frame import render
+    from stage_sim.sim.rangers import Scan
+    from stage_sim.sim.simulation import RobotState, Simulation
+    from stage_sim.worldfile.description import WorldDescription
+    from stage_sim.worldfile.errors import WorldError
+    from stage_sim.worldfile.loader import load_world, load_world_text
+
+
+def __getattr__(name: str) -> Any:
+    """PEP 562: import the module behind a public name when it is first asked for."""
+    if name not in _PUBLIC:
+        raise AttributeError(f"module 'stage_sim' has no attribute {name!r}")
+    return getattr(importlib.import_module(_PUBLIC[name]), name)

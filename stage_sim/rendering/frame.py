@@ -15,17 +15,14 @@ import math
 import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from PIL import Image, ImageDraw
 
-from stage_sim.core.body_geometry import body_polygons, global_poses, transform_points
+from stage_sim.maps.body_geometry import body_polygons, global_poses, transform_points
 from stage_sim.rendering import palette
 from stage_sim.rendering.caption import caption_strip, draw_clock
-
-if TYPE_CHECKING:
-    from stage_sim.core.simulation import Simulation
+from stage_sim.sim.simulation import Simulation
 
 DEFAULT_LONG_SIDE_PX = 800
 """Longer side of the map when the world has no ``window`` to take a scale from."""
@@ -223,14 +220,20 @@ def renderer_for(sim: Simulation) -> FrameRenderer:
     return renderer
 
 
-def render_frame(
+def render(
     sim: Simulation,
     scale: float | None = None,
     lasers: bool = True,
     trails: Sequence[np.ndarray] | None = None,
     grid: bool = False,
 ) -> np.ndarray:
-    """What :meth:`Simulation.render` returns: the current state as an (H, W, 3) uint8 array."""
+    """The world now, as Stage's window shows it: an (H, W, 3) uint8 RGB image with +y up.
+
+    Static world, robot bodies with a heading nose, laser rays to their hits (``lasers``), per robot an
+    (M, 2) array of past positions as a trail (``trails``, NaN rows break a line), a grid, the sim clock
+    and a scale bar. ``scale`` is pixels per metre (default: the world's ``window scale``); the frame
+    covers the static world, so every frame of a run has the same size.
+    """
     return np.array(renderer_for(sim).image(Snapshot.of(sim), scale, lasers, trails, grid))
 
 

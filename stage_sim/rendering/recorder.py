@@ -1,6 +1,6 @@
 """Record a running simulation as an animated GIF (every frame) or a PNG (the last frame).
 
-Usage, by any loop that steps a :class:`~stage_sim.core.simulation.Simulation`::
+Usage, by any loop that steps a :class:`~stage_sim.sim.simulation.Simulation`::
 
     recorder = Recorder(sim, "run.gif", every_s=0.5)   # captures the current state as the first frame
     while running:
@@ -19,15 +19,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 from PIL import Image
 
 from stage_sim.rendering.frame import Snapshot, renderer_for
-
-if TYPE_CHECKING:
-    from stage_sim.core.simulation import Simulation
+from stage_sim.sim.simulation import Simulation
 
 FORMATS = (".gif", ".png")
 

@@ -1,1 +1,1 @@
-"""The thin ROS 2 layer over :mod:`stage_sim.core`: nodes, message conversions, names, TF and clock."""
+"""The thin ROS 2 layer over the ROS-free core: nodes, message conversions, names, TF and clock."""

@@ -13,10 +13,10 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
-from stage_sim.core.occupancy import OccupancyGrid
-from stage_sim.core.ranger_sensing import Scan
-from stage_sim.core.robot_model import RangerSpec
-from stage_sim.core.world_description import Pose
+from stage_sim.sim.rangers import Scan
+from stage_sim.sim.robots import RangerSpec
+from stage_sim.worldfile.description import Pose
+from stage_sim.worldfile.occupancy import OccupancyGrid
 
 
 def stamp(sim_time_us: int) -> Time:

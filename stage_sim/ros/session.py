@@ -4,7 +4,7 @@ One process and one executor spare the launch machinery and, with ``speedup <= 0
 the world, then spin until every wanderer has answered that step's scan with a command the simulator has
 received (or a short wall timeout passes), so a seed gives the same run every time. With ``speedup > 0`` a
 steady wall timer paces the steps at ``interval_sim / speedup``, as the simulator's own would. Either way
-:class:`~stage_sim.core.run_stats.RunStats` samples the ground truth after every step and gives the JSON
+:class:`~stage_sim.runs.stats.RunStats` samples the ground truth after every step and gives the JSON
 summaries printed at exit.
 """
 
@@ -23,13 +23,13 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
-from stage_sim.core.errors import WorldError
-from stage_sim.core.run_stats import RunStats
-from stage_sim.core.wander_driver import wanderer_seed
 from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.wander import Wander
+from stage_sim.runs.driver import wanderer_seed
+from stage_sim.runs.stats import RunStats
+from stage_sim.worldfile.errors import WorldError
 
 LOCKSTEP_TIMEOUT_S = 0.5  # wall seconds to wait for the wanderers' answers before stepping anyway
 CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subscriptions to match

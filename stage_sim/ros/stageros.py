@@ -1,4 +1,4 @@
-"""The ``stageros`` node: a thin rclpy layer that steps a :class:`~stage_sim.core.simulation.Simulation`.
+"""The ``stageros`` node: a thin rclpy layer that steps a :class:`~stage_sim.sim.simulation.Simulation`.
 
 Per robot it subscribes ``cmd_vel`` and publishes ``odom``, ``base_pose_ground_truth``, ``base_scan[_k]``
 and ``stall``; for the world it publishes ``/clock`` (one per step, never 0), ``/tf`` (odom →
@@ -30,11 +30,11 @@ from std_msgs.msg import Bool
 from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
-from stage_sim.core.bundled import find_world
-from stage_sim.core.simulation import Simulation
-from stage_sim.core.world_loader import load_world
 from stage_sim.ros import conversions
 from stage_sim.ros.names import RobotNames, robot_names
+from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.bundled import find_world
+from stage_sim.worldfile.loader import load_world
 
 # Commands beyond this magnitude (m/s or rad/s) are treated as garbage, not as "go very fast".
 ABSURD_COMMAND = 1e3

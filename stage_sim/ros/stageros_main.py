@@ -17,9 +17,9 @@ import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import remove_ros_args
 
-from stage_sim.core.bundled import bundled_worlds
-from stage_sim.core.errors import WorldError
 from stage_sim.ros.recording import add_record_arguments, recording
+from stage_sim.worldfile.bundled import bundled_worlds
+from stage_sim.worldfile.errors import WorldError
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:

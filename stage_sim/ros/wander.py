@@ -1,7 +1,7 @@
 """``wander [--ros-args ...]``: a reactive wanderer that never stops, never collides and explores the map.
 
 Subscribes ``base_scan`` and ``odom`` (relative, so a namespace selects the robot) and publishes one
-``geometry_msgs/Twist`` on ``cmd_vel`` per scan, decided by :class:`stage_sim.core.reactive.Wanderer`
+``geometry_msgs/Twist`` on ``cmd_vel`` per scan, decided by :class:`stage_sim.wander.reactive.Wanderer`
 (see there for the strategy). Each scan is paired with the odometry of the same stamp, so the remembered
 obstacle points behind the robot stay where they were; the laser's mounting comes from ``/tf_static``
 (parameter ``laser_pose`` until it has arrived). Parameters: ``forward_speed`` (m/s), ``safety_distance`` (m),
@@ -31,9 +31,10 @@ from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from stage_sim.core.laser_reading import LaserReading
-from stage_sim.core.reactive import WanderConfig, Wanderer
 from stage_sim.ros.interrupts import stop_requests
+from stage_sim.wander.config import WanderConfig
+from stage_sim.wander.laser_reading import LaserReading
+from stage_sim.wander.reactive import Wanderer
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 # Only the newest scan matters: a backlog (a slow start, a loaded machine) would replay stale scans, each

@@ -16,9 +16,9 @@ from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from stage_sim.core.bundled import find_world
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.wander import Wander
+from stage_sim.worldfile.bundled import find_world
 from tests.ros.helpers import spin_until
 
 WANDER = Path(sys.executable).with_name("wander")

@@ -1,0 +1,184 @@
+"""Lasers: every due beam of every ranger of every robot cast in one batch per height, then Stage's noise.
+
+Rays are grouped by height because of Stage's 2.5D rule (a ray sees a model only if its height lies in the
+model's z band); worlds have one or two distinct laser heights, each with its own precomputed static
+layer. Other robots are seen through their outline cells, placed fresh at every sensing step; a ray never
+sees its own robot. A ranger produces a new scan when ``update_interval`` has passed since its last one.
+
+Noise (``noise [c p a]``, Stage 4.3): each beam's direction is perturbed by inc·a·U/2 and a hit's range
+becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with variance c; misses stay at
+``range_max``. The draws come from the simulation's seeded generator, so a seed fixes every scan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stage_sim.maps.raster import StaticRaster
+from stage_sim.sensing.raycast import GridRayCaster
+from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
+from stage_sim.sim.collision import Bodies, GridFrame, place
+from stage_sim.sim.robots import RobotSpec
+
+
+@dataclass
+class Scan:
+    """One ranger's latest measurement: ranges (m) and intensities per beam, CCW, and its sim stamp (s)."""
+
+    ranges: np.ndarray
+    intensities: np.ndarray
+    stamp: float
+
+
+@dataclass(frozen=True)
+class _HeightGroup:
+    """The rays cast at one height, with the static layer and the robots visible there."""
+
+    rays: np.ndarray
+    caster: GridRayCaster
+    robots: RobotLayer
+    intensity: np.ndarray
+    robot_visible: np.ndarray
+    robot_return: np.ndarray
+
+
+class RangerSensing:
+    """Holds the beam tables of all rangers and produces their scans."""
+
+    def __init__(self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame) -> None:
+        self._bodies = bodies
+        self._grid = grid
+        self._rangers = [(robot.index, ranger) for robot in robots for ranger in robot.rangers]
+        owners, offsets, angles, ranges, heights, ranger_of_ray = [], [], [], [], [], []
+        for k, (robot_index, ranger) in enumerate(self._rangers):
+            beams = ranger.beam_angles
+            owners.append(np.full(len(beams), robot_index))
+            offsets.append(np.tile(ranger.ray_offset, (len(beams), 1)))
+            angles.append(ranger.ray_yaw + beams)
+            ranges.append(np.full(len(beams), ranger.sensor.range_max))
+            heights.append(np.full(len(beams), ranger.ray_height))
+            ranger_of_ray.append(np.full(len(beams), k))
+        self._owner = np.concatenate(owners).astype(np.int64) if owners else np.zeros(0, np.int64)
+        self._offset = np.concatenate(offsets) if offsets else np.zeros((0, 2))
+        self._angle = np.concatenate(angles) if angles else np.zeros(0)
+        self._max_range = np.concatenate(ranges) if ranges else np.zeros(0)
+        self._ranger_of_ray = np.concatenate(ranger_of_ray).astype(np.int64) if ranger_of_ray else np.zeros(0, int)
+        self._increment = np.array([r.sensor.fov / max(r.sensor.samples - 1, 1) for _, r in self._rangers])
+        self._noise = np.array([r.sensor.noise for _, r in self._rangers]).reshape(-1, 3)
+        self._interval_us = np.array([round(r.update_interval * 1e6) for _, r in self._rangers], dtype=np.int64)
+        ray_height = np.concatenate(heights) if heights else np.zeros(0)
+        self._groups = self._height_groups(robots, static, ray_height)
+        self._slices = self._ranger_slices()
+        self.latest: list[list[Scan]] = [[] for _ in robots]
+        self._rng = np.random.default_rng()
+        self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
+        self._stale = True
+
+    def reset(self, rng: np.random.Generator) -> None:
+        """Use ``rng`` for the noise from now on."""
+        self._rng = rng
+
+    def invalidate(self) -> None:
+        """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
+        self._stale = True
+
+    def sense(self, poses: np.ndarray, time: float) -> None:
+        """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``."""
+        now_us = round(time * 1e6)
+        due = np.full(len(self._rangers), self._stale) | ((now_us - self._last_us) >= self._interval_us)
+        self._stale = False
+        if not due.any():
+            return
+        self._last_us[due] = now_us
+        ray_due = due[self._ranger_of_ray]
+        ranges = np.empty(len(self._owner))
+        intensity = np.zeros(len(self._owner), dtype=np.float32)
+        robot_cells = self._bodies.point_cells(poses, self._grid) if self._bodies.count > 1 else None
+        jitter = self._angle_jitter(ray_due)
+        for group in self._groups:
+            rays = group.rays[ray_due[group.rays]]
+            if rays.size:
+                self._cast(group, rays, poses, jitter, robot_cells, ranges, intensity)
+        noisy = self._apply_noise(ranges, ray_due)
+        for k in np.flatnonzero(due):
+            robot_index, ranger = self._rangers[k]
+            part = self._slices[k]
+            scan = Scan(noisy[part].astype(np.float32), intensity[part], time)
+            robot_scans = self.latest[robot_index]
+            if ranger.index < len(robot_scans):
+                robot_scans[ranger.index] = scan
+            else:
+                robot_scans.append(scan)
+
+    def _cast(
+        self, group: _HeightGroup, rays: np.ndarray, poses: np.ndarray, jitter: np.ndarray,
+        robot_cells: np.ndarray | None, ranges: np.ndarray, intensity: np.ndarray,
+    ) -> None:
+        owner = self._owner[rays]
+        pose = poses[owner]
+        origins = place(self._offset[rays], pose)
+        angles = pose[:, 2] + self._angle[rays] + jitter[rays]
+        layer = None
+        if robot_cells is not None:
+            width = self._grid.shape[1]
+            group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+            layer = group.robots
+        result = group.caster.cast(origins, angles, self._max_range[rays], owners=owner, robots=layer)
+        ranges[rays] = result.ranges
+        static_hit = result.hit_cell >= 0
+        hits = np.zeros(len(rays), dtype=np.float32)
+        hits[static_hit] = group.intensity.ravel()[result.hit_cell[static_hit]]
+        robot_hit = result.hit_robot >= 0
+        hits[robot_hit] = group.robot_return[result.hit_robot[robot_hit]]
+        # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
+        hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
+        intensity[rays] = hits
+
+    def _angle_jitter(self, ray_due: np.ndarray) -> np.ndarray:
+        """Stage's beam-direction noise inc·a·U/2 for due beams of rangers with an angle noise, else 0."""
+        jitter = np.zeros(len(self._owner))
+        angle_noise = self._noise[self._ranger_of_ray, 2]
+        rays = np.flatnonzero(ray_due & (angle_noise != 0.0))
+        if rays.size:
+            scale = self._increment[self._ranger_of_ray[rays]] * angle_noise[rays] / 2
+            jitter[rays] = scale * self._rng.uniform(-1.0, 1.0, len(rays))
+        return jitter
+
+    def _apply_noise(self, ranges: np.ndarray, ray_due: np.ndarray) -> np.ndarray:
+        """Stage's per-beam noise for rangers that have some; other beams pass unchanged."""
+        noise = self._noise[self._ranger_of_ray]
+        noisy_ray = ray_due & np.any(noise != 0.0, axis=1)
+        if not noisy_ray.any():
+            return ranges
+        out = ranges.copy()
+        rays = np.flatnonzero(noisy_ray)
+        const, prop = noise[rays, 0], noise[rays, 1]
+        u_range = self._rng.uniform(-1.0, 1.0, len(rays))
+        gauss = self._rng.normal(0.0, 1.0, len(rays)) * np.sqrt(const)
+        hit = ranges[rays] < self._max_range[rays]
+        out[rays] = np.where(hit, ranges[rays] + ranges[rays] * prop * u_range + gauss, ranges[rays])
+        return out
+
+    def _height_groups(self, robots: list[RobotSpec], static: StaticRaster, ray_height: np.ndarray) -> list:
+        groups = []
+        returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
+        for height in np.unique(ray_height):
+            occupied, intensity = static.sensing_layer(float(height))
+            visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
+            caster = GridRayCaster(occupied, static.resolution, static.origin_xy)
+            groups.append(_HeightGroup(
+                rays=np.flatnonzero(ray_height == height),
+                caster=caster,
+                robots=RobotLayer(caster.windows, caster.resolution, caster.origin_xy),
+                intensity=intensity,
+                robot_visible=visible,
+                robot_return=returns,
+            ))
+        return groups
+
+    def _ranger_slices(self) -> list[slice]:
+        counts = np.bincount(self._ranger_of_ray, minlength=len(self._rangers))
+        ends = np.cumsum(counts)
+        return [slice(int(e - n), int(e)) for n, e in zip(counts, ends, strict=True)]

@@ -1,0 +1,139 @@
+"""What the simulation needs to know about each robot and each of its lasers, read once from the world.
+
+A robot is a position model (stageros' rule: every position model, indexed in pre-order DFS). Its body is
+the outline of every block in its subtree (the robot's own blocks and those of attached models such as
+the laser housing), expressed in the robot frame. Its rangers are the ranger models whose *direct* parent
+is the position model, one scan per ranger from its first sensor, as stageros publishes them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from stage_sim.maps.body_geometry import body_polygons, global_poses, transform_points
+from stage_sim.maps.polygon_raster import outline_points
+from stage_sim.sim.kinematics import DRIVE_CODES
+from stage_sim.worldfile.description import Model, Pose, PositionSettings, Sensor, WorldDescription, WorldWarning
+
+
+@dataclass(frozen=True)
+class RangerSpec:
+    """One simulated laser: where it sits on its robot and which beams it casts."""
+
+    name: str
+    index: int
+    pose: Pose
+    sensor: Sensor
+    update_interval: float
+    ray_offset: tuple[float, float]
+    ray_yaw: float
+    ray_height: float
+
+    @property
+    def beam_angles(self) -> np.ndarray:
+        """Beam directions relative to the sensor, counter-clockwise from −fov/2 (Stage's order)."""
+        samples = self.sensor.samples
+        if samples == 1:
+            return np.zeros(1)
+        return -self.sensor.fov / 2 + np.arange(samples) * (self.sensor.fov / (samples - 1))
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """A position model and everything attached to it, as the simulation steps it."""
+
+    index: int
+    name: str
+    model: Model
+    start: tuple[float, float, float]
+    settings: PositionSettings
+    z_band: tuple[float, float]
+    outline: np.ndarray
+    rangers: tuple[RangerSpec, ...]
+
+    @property
+    def drive_code(self) -> int:
+        """Drive as an integer for the vectorised kinematics."""
+        return DRIVE_CODES[self.settings.drive]
+
+    @property
+    def radius(self) -> float:
+        """Distance from the robot origin to the farthest outline point (bounds rotation sweeps)."""
+        return float(np.hypot(*self.outline.T).max()) if len(self.outline) else 0.0
+
+    @property
+    def min_width(self) -> float:
+        """Smallest side of the outline's bounding box: the body cannot tunnel through less than this."""
+        if len(self.outline) == 0:
+            return 0.0
+        return float((self.outline.max(axis=0) - self.outline.min(axis=0)).min())
+
+
+def build_robots(description: WorldDescription, warnings: list[WorldWarning]) -> list[RobotSpec]:
+    """Every position model of the world as a :class:`RobotSpec`, in stageros' robot order."""
+    poses = global_poses(description)
+    spacing = description.settings.resolution / 2
+    robots = []
+    for index, model in enumerate(description.robots()):
+        pose = poses[id(model)]
+        outline, z_band = _body_outline(model, pose, poses, spacing)
+        rangers = tuple(_rangers(model, pose, poses, warnings))
+        settings = model.position or PositionSettings()
+        robots.append(
+            RobotSpec(index, model.name, model, (pose.x, pose.y, pose.yaw), settings, z_band, outline, rangers)
+        )
+    return robots
+
+
+def _body_outline(
+    robot: Model, robot_pose: Pose, poses: dict[int, Pose], spacing: float
+) -> tuple[np.ndarray, tuple[float, float]]:
+    """Outline points of all bodies in the robot's subtree, in the robot frame, and their joint z band."""
+    points, z_low, z_high = [], math.inf, -math.inf
+    for model in robot.walk():
+        relative = _relative(robot_pose, poses[id(model)])
+        for polygon in body_polygons(model):
+            points.append(transform_points(outline_points(polygon.points, spacing), relative))
+            z_low = min(z_low, relative.z + polygon.z[0])
+            z_high = max(z_high, relative.z + polygon.z[1])
+    if not points:
+        return np.zeros((0, 2)), (0.0, 0.0)
+    return np.concatenate(points), (robot_pose.z + z_low, robot_pose.z + z_high)
+
+
+def _relative(base: Pose, pose: Pose) -> Pose:
+    """``pose`` expressed in the frame ``base`` (both global)."""
+    c, s = math.cos(base.yaw), math.sin(base.yaw)
+    dx, dy = pose.x - base.x, pose.y - base.y
+    return Pose(c * dx + s * dy, -s * dx + c * dy, pose.z - base.z, pose.yaw - base.yaw)
+
+
+def _rangers(robot: Model, robot_pose: Pose, poses: dict[int, Pose], warnings: list[WorldWarning]) -> list[RangerSpec]:
+    rangers = []
+    for child in robot.children:
+        if child.type != "ranger" or not child.sensors:
+            continue
+        if len(child.sensors) > 1:
+            warnings.append(WorldWarning(
+                f"ranger '{child.name}' has {len(child.sensors)} sensors; like stageros only the first is simulated",
+                child.location,
+            ))
+        sensor = child.sensors[0]
+        ranger_pose = _relative(robot_pose, poses[id(child)])
+        # Stage: ray origin = ranger pose ⊕ ranger origin ⊕ sensor pose, raised by half the sensor height.
+        ray = ranger_pose.compose(child.origin).compose(sensor.pose)
+        rangers.append(RangerSpec(
+            name=child.name,
+            index=len(rangers),
+            # stageros' TF: the ranger's pose in its parent, lifted by the robot's height.
+            pose=Pose(child.pose.x, child.pose.y, robot.size[2] + child.pose.z, child.pose.yaw),
+            sensor=sensor,
+            update_interval=child.update_interval,
+            ray_offset=(ray.x, ray.y),
+            ray_yaw=ray.yaw,
+            ray_height=robot_pose.z + ray.z + sensor.size[2] / 2,
+        ))
+    return rangers

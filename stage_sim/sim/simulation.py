@@ -1,0 +1,193 @@
+"""The ROS-free simulation: a Stage world stepped at ``interval_sim``, deterministic for a seed.
+
+One :meth:`Simulation.step` advances sim time by one ``interval_sim`` and, in this order: applies the
+watchdog, turns commands into body velocities (drive + ``velocity_bounds``), moves every robot (refusing
+moves into obstacles: the robot stalls), updates odometry, and casts every due laser from the *new* poses,
+so scans and odometry agree with the ground truth of the same stamp (Stage lags one step; we do not).
+
+Usage::
+
+    sim = Simulation.from_world("worlds/rooms.world", seed=1)
+    sim.set_velocity(0, 0.5, 0.0, 0.2)
+    for _ in range(10):
+        sim.step()
+    sim.true_poses[0], sim.odometry_poses[0], sim.scans[0][0].ranges
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from stage_sim.maps.raster import StaticRaster, build_static_raster
+from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
+from stage_sim.sim.kinematics import body_velocity
+from stage_sim.sim.odometry import draw_odom_errors, integrate_odometry, relative_pose
+from stage_sim.sim.rangers import RangerSensing, Scan
+from stage_sim.sim.robots import RobotSpec, build_robots
+from stage_sim.worldfile.description import WorldDescription, WorldWarning
+
+# Sim time is kept in integer microseconds, like Stage, so that no rounding drift accumulates.
+MICROSECONDS = 1_000_000
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """A snapshot of one robot, for callers that want one object rather than the batched arrays."""
+
+    true_pose: tuple[float, float, float]
+    odometry_pose: tuple[float, float, float]
+    velocity: tuple[float, float, float]
+    stalled: bool
+
+
+class Simulation:
+    """A Stage world in motion: robots, their odometry and their lasers."""
+
+    def __init__(self, description: WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0) -> None:
+        self.description = description
+        self.warnings: list[WorldWarning] = list(description.warnings)
+        self.robots: list[RobotSpec] = build_robots(description, self.warnings)
+        self.interval_us = max(1, round(description.settings.interval_sim * MICROSECONDS))
+        self.watchdog_timeout = watchdog_timeout
+        starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
+        self.static: StaticRaster = build_static_raster(description, starts)
+        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy)
+        self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
+        self._collision = self._make_collision_checker(grid)
+        self._sensing = RangerSensing(self.robots, self.static, self._bodies, grid)
+        n = len(self.robots)
+        self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
+        self._drives = np.array([r.drive_code for r in self.robots], dtype=np.int64)
+        self._wheelbases = np.array([r.settings.wheelbase for r in self.robots], dtype=np.float64)
+        self._bounds = np.array([r.settings.velocity_bounds for r in self.robots], dtype=np.float64).reshape(n, 8)
+        self._uses_odom = np.array([r.settings.localization == "odom" for r in self.robots], dtype=bool)
+        self._odom_origin = np.array(
+            [self._odometry_origin(r) for r in self.robots], dtype=np.float64).reshape(n, 3)
+        for index in np.flatnonzero(self._collision.overlapping(self._start)):
+            robot = self.robots[index]
+            self.warnings.append(WorldWarning(
+                f"robot '{robot.name}' starts overlapping an obstacle or another robot: it will stall until "
+                "it moves clear", robot.model.location))
+        self.reset(seed)
+
+    @classmethod
+    def from_world(
+        cls, world: str | Path | WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0
+    ) -> Simulation:
+        """A simulation of a world file (path) or of an already loaded description."""
+        if not isinstance(world, WorldDescription):
+            from stage_sim.worldfile.loader import load_world
+
+            world = load_world(world)
+        return cls(world, seed=seed, watchdog_timeout=watchdog_timeout)
+
+    # -- lifecycle -------------------------------------------------------------------------------------
+
+    def reset(self, seed: int | None = None) -> None:
+        """Back to the start: time 0, start poses, no motion, fresh scans; a new seed redraws the random parts."""
+        self.rng = np.random.default_rng(seed)
+        self.sim_time_us = 0
+        self.odom_errors = draw_odom_errors([r.settings.odom_error for r in self.robots], self.rng)
+        self._sensing.reset(self.rng)
+        self.reset_positions()
+        self._sensing.sense(self.true_poses, self.sim_time)
+
+    def reset_positions(self) -> None:
+        """What stageros' ``reset_positions`` does here: start poses, no stall, no velocity, fresh odometry.
+
+        Sim time and the random state carry on; every laser scans again at the next step (not now, so that a
+        storm of resets costs nothing). Call it between steps (the ROS layer does)."""
+        n = len(self.robots)
+        self.true_poses = self._start.copy()
+        self.commands = np.zeros((n, 3))
+        self.velocities = np.zeros((n, 3))
+        self.stalled = np.zeros(n, dtype=bool)
+        self.last_command_us = np.full(n, self.sim_time_us, dtype=np.int64)
+        self.odometry_poses = np.where(
+            self._uses_odom[:, None], relative_pose(self._start, self._odom_origin), self._start)
+        self._sensing.invalidate()
+
+    # -- inputs ----------------------------------------------------------------------------------------
+
+    def set_velocity(self, robot: int, vx: float, vy: float, va: float) -> None:
+        """Command robot ``robot`` (Stage ``SetSpeed``): used from the next step until replaced."""
+        self.commands[robot] = (vx, vy, va)
+        self.last_command_us[robot] = self.sim_time_us
+
+    def set_pose(self, robot: int, x: float, y: float, yaw: float) -> None:
+        """Put robot ``robot`` at a new true pose between steps, as dragging a model in Stage's window does.
+
+        The stall flag clears and the lasers scan again at the next step; commands, velocity and odometry
+        carry on (Stage's odometry integrates the robot's own motion, so a moved robot's odometry does not
+        jump). Raises ``ValueError`` for a non-finite pose and ``IndexError`` for an unknown robot."""
+        if not all(np.isfinite((x, y, yaw))):
+            raise ValueError(f"pose must be finite, got ({x}, {y}, {yaw})")
+        if not 0 <= robot < len(self.robots):
+            raise IndexError(f"no robot {robot} (the world has {len(self.robots)})")
+        self.true_poses = self.true_poses.copy()
+        self.true_poses[robot] = (x, y, float(np.remainder(yaw + np.pi, 2 * np.pi) - np.pi))
+        self.stalled[robot] = False
+        self.odometry_poses = np.where(self._uses_odom[:, None], self.odometry_poses, self.true_poses)
+        self._sensing.invalidate()
+
+    # -- stepping --------------------------------------------------------------------------------------
+
+    def step(self) -> None:
+        """Advance the world by one ``interval_sim``."""
+        self.sim_time_us += self.interval_us
+        dt = self.interval_us / MICROSECONDS
+        if self.watchdog_timeout > 0:
+            silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
+            self.commands[silent] = 0.0
+        self.velocities = body_velocity(self.commands, self._drives, self._wheelbases, self._bounds)
+        moved, refused = self._collision.resolve(self.true_poses, self.velocities, dt)
+        moving = np.any(self.velocities != 0.0, axis=1)
+        self.stalled = np.where(moving, refused, self.stalled)
+        self.true_poses = moved
+        odom = integrate_odometry(self.odometry_poses, self.velocities, self.odom_errors, dt)
+        self.odometry_poses = np.where(self._uses_odom[:, None], odom, moved)
+        self._sensing.sense(self.true_poses, self.sim_time)
+
+    # -- queries ---------------------------------------------------------------------------------------
+
+    @property
+    def sim_time(self) -> float:
+        """Simulated seconds since the start (or the last :meth:`reset`)."""
+        return self.sim_time_us / MICROSECONDS
+
+    @property
+    def interval(self) -> float:
+        """Seconds of sim time per step."""
+        return self.interval_us / MICROSECONDS
+
+    @property
+    def scans(self) -> list[list[Scan]]:
+        """Latest scan of every ranger, per robot (``scans[robot][ranger]``)."""
+        return self._sensing.latest
+
+    def state(self, robot: int) -> RobotState:
+        """One robot's true pose, odometry, applied velocity and stall flag."""
+        return RobotState(
+            tuple(self.true_poses[robot]), tuple(self.odometry_poses[robot]),
+            tuple(self.velocities[robot]), bool(self.stalled[robot]),
+        )
+
+    # -- construction helpers --------------------------------------------------------------------------
+
+    def _make_collision_checker(self, grid: GridFrame) -> CollisionChecker:
+        bands = sorted({r.z_band for r in self.robots})
+        layers = [self.static.collision_layer(*band) for band in bands]
+        layer_of_robot = np.array([bands.index(r.z_band) for r in self.robots], dtype=np.int64)
+        collides = np.array([r.model.obstacle_return for r in self.robots], dtype=bool)
+        return CollisionChecker(self._bodies, grid, layers, layer_of_robot, collides)
+
+    @staticmethod
+    def _odometry_origin(robot: RobotSpec) -> tuple[float, float, float]:
+        origin = robot.settings.localization_origin
+        if origin is None:
+            return robot.start
+        return (origin.x, origin.y, origin.yaw)
+

@@ -1,0 +1,123 @@
+"""The wanderer's safety-checked choice of a velocity command: a dynamic-window check of a fixed command set.
+
+Each candidate command is followed along its exact arc (:func:`arc_poses`) for 1.5 s; an arc is clear while
+the body rectangles keep ``safety_distance`` (plus each point's odometry-drift allowance, plus room that grows
+at ``moving_speed`` for points seen moving in) from every obstacle point, and a point already nearer than that
+may come no nearer. Among the arcs that stay clear long enough, the one that best serves the desired heading,
+keeps clearance and leaves room to turn round wins; no command is ever zero.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from stage_sim.wander.config import WanderConfig
+from stage_sim.wander.velocity_arcs import arc_poses, candidate_commands
+
+# Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
+CHECK_TIMES = np.array([0.1, 0.2, 0.3, 0.4, 0.6, 0.8, 1.1, 1.5])
+SAFE_TIMES = np.concatenate([[0.0], CHECK_TIMES[:-1]])  # how long an arc stays clear if it hits at index k
+TURN_CHECK = 4  # index in CHECK_TIMES of the pose (0.6 s) whose turning circle should be clear
+ADMISSIBLE_S = 0.4  # an arc must stay clear this long to be chosen when any does
+LOOK_AHEAD_S = 1.0  # heading and progress of a candidate are judged at this time
+TOLERANCE = 0.005  # m a point already inside the safety distance may come closer (sensor quantisation)
+CLEARANCE_CAP = 0.15  # m of clearance beyond which more is no better
+CLEARANCE_WEIGHT = 2.5  # worth of that clearance against heading and progress (about 1 each)
+PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
+MAX_ALLOWANCE = 0.1  # m: points less certain than this are not planned with (the wanderer forgets them)
+
+
+class ArcPlanner:
+    """The candidate commands of one robot and the geometry to check them: body rectangles and arc poses."""
+
+    def __init__(self, config: WanderConfig) -> None:
+        self.config = config
+        self.commands = candidate_commands(config)
+        self._poses = arc_poses(self.commands, CHECK_TIMES)
+        self._look = arc_poses(self.commands, np.array([LOOK_AHEAD_S]))[:, 0]
+        self.boxes = np.array(config.footprint, dtype=np.float64).reshape(-1, 4)
+        boxes = self.boxes
+        self.radius = float(np.hypot(np.abs(boxes[:, :2]).max(axis=1), np.abs(boxes[:, 2:]).max(axis=1)).max())
+        # Candidates grouped by linear speed, with how far from the centre a point can matter to them.
+        speeds = np.round(np.hypot(self.commands[:, 0], self.commands[:, 1]), 6)
+        margin = config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
+        self._groups = [(v * CHECK_TIMES[-1] + self.radius + margin, np.flatnonzero(speeds == v))
+                        for v in np.unique(speeds)]
+
+    def choose(
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
+        previous_turn: float, door: bool, backing: bool, turn_sign: float, reverse_room: float,
+        retreat_turn: float | None = None,
+    ) -> int:
+        """Index of the best command for ``heading`` (robot frame) among those whose arc keeps clear.
+
+        ``door``: passing a narrow doorway (little clearance, no room to turn: ask for less); ``backing``:
+        getting out of a tight spot (half the margin will do, reversing is preferred); ``turn_sign``: turns
+        the other way are penalised (0: none); ``reverse_room``: metres behind known to be clear (the laser
+        does not see backwards); ``retreat_turn``: retreating, the reverse command nearest this turn rate
+        wins if any is clear (and no allowance for odometry drift is made: the body has just been there).
+        """
+        config = self.config
+        # How near each point could come within the horizon: moving ones come nearer.
+        distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
+        near = distance < self._groups[-1][0]
+        _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
+        order = thin[np.argsort(distance[near][thin])]
+        points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
+        moving = moving[near][order]
+        now = self.body_distance(points[:, 0], points[:, 1])
+        retreating = retreat_turn is not None
+        if retreating:
+            allowance = np.zeros_like(allowance)
+        keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
+                    + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
+        limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+        closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
+        for reach, rows in self._groups:  # a slow arc only needs the points it can reach
+            count = int(np.searchsorted(distance, reach))
+            if count:
+                x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
+                c, s = np.cos(yaw), np.sin(yaw)
+                dx, dy = points[:count, 0] - x, points[:count, 1] - y
+                margin = self.body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:, :count]
+                closest[rows] = margin.min(axis=2)
+        hit = np.logical_or.accumulate(closest < 0, axis=1)
+        safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+        clearance = np.where(hit, np.inf, closest).min(axis=1)
+        look_x, look_y, look_yaw = self._look.T
+        progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
+        speed = self.commands[:, 0]
+        score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
+                 + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
+                 - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
+                 - (1.0 if door else 8.0) * self._cramped(points)
+                 - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
+                 - 3.0 * (self.commands[:, 2] * turn_sign < 0))
+        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
+        admissible = (safe_until >= ADMISSIBLE_S) & reversible
+        if retreating and (admissible & (speed < 0)).any():
+            admissible &= speed < 0
+            score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
+        if not admissible.any():  # nothing stays clear long enough: of what may be done, whatever stays clear
+            longest = np.where(reversible, safe_until, -1.0)  # longest, then with least intrusion in its first step
+            admissible = longest == longest.max()
+            score = closest[:, 0]
+        return int(np.argmax(np.where(admissible, score, -np.inf)))
+
+    def _cramped(self, points: np.ndarray) -> np.ndarray:
+        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
+        x, y = (self._poses[:, TURN_CHECK, k, None] for k in range(2))
+        nearest = np.hypot(points[:, 0] - x, points[:, 1] - y).min(axis=1, initial=np.inf)
+        return np.maximum(self.radius + self.config.safety_distance - nearest, 0.0)
+
+    def body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Distance from body-frame points to the body (0 inside): the nearest of its rectangles."""
+        distance = None
+        for x_min, x_max, y_min, y_max in self.boxes:
+            dx = np.maximum(np.maximum(x - x_max, x_min - x), 0.0)
+            dy = np.maximum(np.maximum(y - y_max, y_min - y), 0.0)
+            box = np.hypot(dx, dy)
+            distance = box if distance is None else np.minimum(distance, box)
+        return distance

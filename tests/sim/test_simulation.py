@@ -1,0 +1,292 @@
+"""The Simulation core on small synthetic worlds with hand-computed expectations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.description import WorldDescription
+from stage_sim.worldfile.loader import load_world_text
+
+# A 10 m × 10 m room of 2 cm walls; robot bodies 0.4 × 0.3 × 0.2 m; lasers 0.1 m ahead of the centre at
+# height 0.2 − 0.1 + 0.01 (half the default sensor height) = 0.11 m, low enough to see other robots.
+ROOM = """
+resolution 0.02
+interval_sim 100
+define wall model ( color "black" )
+wall( name "south" size [10 0.02 1] pose [5 0 0 0] )
+wall( name "north" size [10 0.02 1] pose [5 10 0 0] )
+wall( name "west" size [0.02 10 1] pose [0 5 0 0] )
+wall( name "east" size [0.02 10 1] pose [10 5 0 0] )
+define laser ranger ( sensor( range [0 8] fov 180 samples 181 ) size [0.05 0.05 0.05] )
+define bot position ( size [0.4 0.3 0.2] drive "{drive}" {extra} laser( pose [0.1 0 -0.1 0] ) )
+"""
+
+
+def world(robots: str, drive: str = "diff", extra: str = "", more: str = "") -> WorldDescription:
+    text = ROOM.format(drive=drive, extra=extra) + more + robots
+    return load_world_text(text, "test.world")
+
+
+def sim_of(robots: str, seed: int | None = 0, **kwargs) -> Simulation:
+    return Simulation(world(robots, **kwargs), seed=seed)
+
+
+def test_diff_step_through_the_simulation() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] )')
+    sim.set_velocity(0, 0.5, 0.3, 0.1)
+    sim.step()
+    assert sim.sim_time == pytest.approx(0.1)
+    assert sim.true_poses[0] == pytest.approx([2.05, 2.0, 0.01])
+    assert sim.velocities[0] == pytest.approx([0.5, 0.0, 0.1])
+
+
+def test_omni_and_car_drives() -> None:
+    omni = sim_of('bot( pose [2 2 0 90] )', drive="omni")
+    omni.set_velocity(0, 0.0, 0.4, 0.0)
+    omni.step()
+    assert omni.true_poses[0] == pytest.approx([1.96, 2.0, math.pi / 2])
+    car = sim_of('bot( pose [2 2 0 0] )', drive="car", extra="wheelbase 0.5")
+    car.set_velocity(0, 0.8, 0.0, 0.3)
+    car.step()
+    assert car.true_poses[0] == pytest.approx([2 + 0.08 * math.cos(0.3), 2.0, 0.08 * math.sin(0.3) / 0.5])
+
+
+def test_commands_are_clamped_to_default_velocity_bounds() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] )')
+    sim.set_velocity(0, 3.0, 0.0, 9.0)
+    sim.step()
+    assert sim.true_poses[0] == pytest.approx([2.1, 2.0, math.pi / 20])
+
+
+def test_odometry_with_literal_odom_error() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] )', extra='localization "odom" odom_error [0.1 0.0 0.0 0.0]')
+    assert sim.odometry_poses[0] == pytest.approx([0.0, 0.0, 0.0])
+    sim.set_velocity(0, 0.5, 0.0, 0.0)
+    for _ in range(4):
+        sim.step()
+    assert sim.true_poses[0] == pytest.approx([2.2, 2.0, 0.0])
+    assert sim.odometry_poses[0] == pytest.approx([0.22, 0.0, 0.0])
+
+
+def test_gps_odometry_is_the_true_pose() -> None:
+    sim = sim_of('bot( pose [2 2 0 30] )')
+    sim.set_velocity(0, 0.5, 0.0, 0.5)
+    for _ in range(5):
+        sim.step()
+    assert np.array_equal(sim.odometry_poses, sim.true_poses)
+
+
+def test_localization_origin_sets_the_odometry_frame() -> None:
+    extra = 'localization "odom" odom_error [0 0 0 0] localization_origin [1 1 0 0]'
+    sim = sim_of('bot( pose [2 3 0 0] )', extra=extra)
+    assert sim.odometry_poses[0] == pytest.approx([1.0, 2.0, 0.0])
+
+
+def test_drawn_odom_error_depends_on_the_seed_only() -> None:
+    robots = 'bot( pose [2 2 0 0] ) bot( pose [4 4 0 0] )'
+    a = sim_of(robots, seed=1, extra='localization "odom"')
+    b = sim_of(robots, seed=1, extra='localization "odom"')
+    c = sim_of(robots, seed=2, extra='localization "odom"')
+    assert np.array_equal(a.odom_errors, b.odom_errors)
+    assert not np.array_equal(a.odom_errors, c.odom_errors)
+    assert not np.array_equal(a.odom_errors[0], a.odom_errors[1])
+
+
+def test_stall_against_a_wall_undoes_the_move_and_odometry_runs_on() -> None:
+    sim = sim_of('bot( pose [9.5 5 0 0] )', extra='localization "odom" odom_error [0 0 0 0]')
+    sim.set_velocity(0, 1.0, 0.0, 0.0)
+    for _ in range(10):
+        sim.step()
+    assert sim.stalled[0]
+    # body front at x + 0.2 must stay short of the wall's first cell (x = 9.98)
+    assert sim.true_poses[0][0] + 0.2 < 9.98
+    assert sim.true_poses[0][0] >= 9.7 - 1e-9
+    assert sim.odometry_poses[0][0] == pytest.approx(1.0)  # 10 steps × 0.1 m, wheels spinning
+    sim.set_velocity(0, -0.5, 0.0, 0.0)
+    sim.step()
+    assert not sim.stalled[0]
+
+
+def test_stall_against_another_robot() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] ) bot( pose [2.7 2 0 0] )')
+    sim.set_velocity(0, 1.0, 0.0, 0.0)
+    for _ in range(5):
+        sim.step()
+    assert sim.stalled[0] and not sim.stalled[1]
+    gap = sim.true_poses[1][0] - sim.true_poses[0][0]
+    assert 0.4 <= gap < 0.55
+    assert sim.true_poses[1] == pytest.approx([2.7, 2.0, 0.0])
+
+
+def test_no_tunnelling_through_a_one_cell_wall_at_maximum_speed() -> None:
+    fast = 'velocity_bounds [-20 20 -20 20 -1 1 -90 90]'
+    thin = 'wall( name "thin" size [0.02 10 1] pose [5.01 5 0 0] )\n'
+    sim = sim_of('bot( pose [4 5 0 0] )', extra=fast, more=thin)
+    sim.set_velocity(0, 20.0, 0.0, 0.0)  # 2 m per step: five body lengths
+    for _ in range(5):
+        sim.step()
+        assert sim.true_poses[0][0] < 5.0
+    assert sim.stalled[0]
+
+
+def test_reset_positions_restores_start_and_clears_state() -> None:
+    sim = sim_of('bot( pose [9.5 5 0 0] )', extra='localization "odom" odom_error [0 0 0 0]')
+    sim.set_velocity(0, 1.0, 0.0, 0.3)
+    for _ in range(8):
+        sim.step()
+    time = sim.sim_time
+    sim.reset_positions()
+    assert sim.true_poses[0] == pytest.approx([9.5, 5.0, 0.0])
+    assert sim.odometry_poses[0] == pytest.approx([0.0, 0.0, 0.0])
+    assert not sim.stalled[0]
+    assert np.all(sim.velocities == 0) and np.all(sim.commands == 0)
+    assert sim.sim_time == time
+    sim.step()
+    assert sim.true_poses[0] == pytest.approx([9.5, 5.0, 0.0])
+
+
+def test_set_pose_moves_a_stalled_robot_clear_and_its_laser_sees_from_there() -> None:
+    sim = sim_of('bot( pose [9.5 5 0 0] )', extra='localization "odom" odom_error [0 0 0 0]')
+    sim.set_velocity(0, 1.0, 0.0, 0.0)
+    for _ in range(5):
+        sim.step()
+    assert sim.stalled[0]
+    odometry = sim.odometry_poses[0].copy()
+    sim.set_pose(0, 5.0, 5.0, 3 * math.pi / 2)
+    assert sim.true_poses[0] == pytest.approx([5.0, 5.0, -math.pi / 2])
+    assert not sim.stalled[0]
+    assert sim.odometry_poses[0] == pytest.approx(odometry)  # dragging is not wheel motion
+    sim.set_velocity(0, 0.0, 0.0, 0.0)
+    sim.step()
+    centre = sim.scans[0][0].ranges[90]  # straight ahead: south wall, from the laser 0.1 m ahead
+    assert centre == pytest.approx(5.0 - 0.1 - 0.02 / 2, abs=0.02)
+
+
+def test_set_pose_rejects_unknown_robots_and_non_finite_poses() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] )')
+    with pytest.raises(IndexError):
+        sim.set_pose(1, 1.0, 1.0, 0.0)
+    with pytest.raises(ValueError):
+        sim.set_pose(0, math.nan, 1.0, 0.0)
+    assert sim.true_poses[0] == pytest.approx([2.0, 2.0, 0.0])
+
+
+def test_watchdog_stops_a_robot_without_commands() -> None:
+    sim = Simulation(world('bot( pose [2 2 0 0] )'), seed=0, watchdog_timeout=0.2)
+    sim.set_velocity(0, 0.5, 0.0, 0.0)
+    sim.step()
+    assert sim.velocities[0][0] == pytest.approx(0.5)
+    sim.step()
+    assert sim.velocities[0][0] == 0.0
+    x = sim.true_poses[0][0]
+    sim.step()
+    assert sim.true_poses[0][0] == x
+
+
+def test_scan_range_is_the_distance_to_the_first_wall_cell() -> None:
+    sim = sim_of('bot( pose [2 5 0 0] )')
+    scan = sim.scans[0][0]
+    assert len(scan.ranges) == 181
+    # laser at x = 2.1; the east wall spans [9.99, 10.01], so its first cell starts at x = 9.98
+    assert scan.ranges[90] == pytest.approx(9.98 - 2.1 if 9.98 - 2.1 < 8 else 8.0)
+    assert scan.ranges[90] == pytest.approx(7.88)
+    assert scan.intensities[90] == pytest.approx(1.0)
+    # straight left (beam 180, +90°) hits the north wall: first cell at y = 9.98
+    assert scan.ranges[180] == pytest.approx(9.98 - 5.0, abs=1e-6)
+
+
+def test_scans_follow_the_post_move_pose_and_update_interval() -> None:
+    sim = sim_of('bot( pose [2 5 0 0] )', more="")
+    sim.set_velocity(0, 0.5, 0.0, 0.0)
+    sim.step()
+    assert sim.scans[0][0].stamp == pytest.approx(0.1)
+    assert sim.scans[0][0].ranges[90] == pytest.approx(7.83)
+    slow = load_world_text(ROOM.replace("size [0.05 0.05 0.05] )", "size [0.05 0.05 0.05] update_interval 200 )")
+                           .format(drive="diff", extra="") + 'bot( pose [2 5 0 0] )', "slow.world")
+    sim = Simulation(slow, seed=0)
+    stamps = []
+    for _ in range(4):
+        sim.step()
+        stamps.append(round(sim.scans[0][0].stamp, 6))
+    assert stamps == [0.0, 0.2, 0.2, 0.4]
+
+
+def test_low_obstacles_are_invisible_to_high_lasers_and_transparent_ones_to_all() -> None:
+    low = 'model( size [0.5 0.5 0.05] pose [5 5 0 0] )\n'
+    sim = sim_of('bot( pose [2 5 0 0] )', more=low)
+    # laser height 0.11 m > 0.05 m
+    assert sim.scans[0][0].ranges[90] == pytest.approx(7.88)
+    glass = 'model( size [0.5 0.5 1] pose [5 5 0 0] ranger_return -1 )\n'
+    sim = sim_of('bot( pose [2 5 0 0] )', more=glass)
+    assert sim.scans[0][0].ranges[90] == pytest.approx(7.88)
+    wall = 'model( size [0.5 0.5 1] pose [5 5 0 0] ranger_return 3 )\n'
+    sim = sim_of('bot( pose [2 5 0 0] )', more=wall)
+    assert sim.scans[0][0].ranges[90] == pytest.approx(4.74 - 2.1)
+    assert sim.scans[0][0].intensities[90] == pytest.approx(3.0)
+
+
+def test_lasers_see_other_robots_but_not_their_own() -> None:
+    sim = sim_of('bot( pose [2 5 0 0] ) bot( pose [4 5 0 180] )')
+    # robot 1's body spans x ∈ [3.8, 4.2]: its outline cell starts at 3.8
+    assert sim.scans[0][0].ranges[90] == pytest.approx(3.8 - 2.1, abs=0.021)
+    # looking right (−90°) through its own body: the south wall's first cell ends at y = 0.02
+    assert sim.scans[0][0].ranges[0] == pytest.approx(5.0 - 0.02)
+
+
+def test_same_seed_same_everything_with_noise() -> None:
+    noisy = ROOM.replace("samples 181 )", "samples 181 noise [0.0004 0.01 1] )")
+
+    def run(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        sim = Simulation(load_world_text(noisy.format(drive="diff", extra='localization "odom"')
+                                         + 'bot( pose [2 5 0 0] ) bot( pose [6 6 0 90] )', "n.world"), seed=seed)
+        poses, odoms, scans = [], [], []
+        for k in range(30):
+            sim.set_velocity(0, 0.4, 0.0, 0.2 * math.sin(k / 5))
+            sim.set_velocity(1, 0.3, 0.0, -0.1)
+            sim.step()
+            poses.append(sim.true_poses.copy())
+            odoms.append(sim.odometry_poses.copy())
+            scans.append(np.concatenate([s.ranges for r in sim.scans for s in r]))
+        return np.array(poses), np.array(odoms), np.array(scans)
+
+    a, b, c = run(5), run(5), run(6)
+    for x, y in zip(a, b, strict=True):
+        assert np.array_equal(x, y)
+    assert not np.array_equal(a[1], c[1])
+    assert not np.array_equal(a[2], c[2])
+
+
+def test_reset_with_seed_restarts_time_and_random_draws() -> None:
+    sim = sim_of('bot( pose [2 2 0 0] )', seed=3, extra='localization "odom"')
+    errors = sim.odom_errors.copy()
+    sim.set_velocity(0, 0.5, 0.0, 0.0)
+    sim.step()
+    sim.reset(seed=3)
+    assert sim.sim_time == 0.0
+    assert np.array_equal(sim.odom_errors, errors)
+    assert sim.true_poses[0] == pytest.approx([2.0, 2.0, 0.0])
+
+
+def test_a_robot_starting_inside_a_wall_is_reported() -> None:
+    sim = sim_of('bot( pose [9.9 5 0 0] name "stuck" ) bot( pose [2 2 0 0] name "free" )')
+    messages = [w.message for w in sim.warnings]
+    assert any("'stuck' starts overlapping" in m for m in messages)
+    assert not any("'free'" in m for m in messages)
+
+
+def test_resets_cast_no_rays_and_the_next_step_scans_from_the_start_pose() -> None:
+    sim = sim_of('bot( pose [2 5 0 0] )')
+    sim.set_velocity(0, 1.0, 0.0, 0.0)
+    for _ in range(5):
+        sim.step()
+    before = sim.scans[0][0]
+    for _ in range(1000):
+        sim.reset_positions()
+    assert sim.scans[0][0] is before  # a storm of resets costs no ray casting
+    sim.step()
+    assert sim.scans[0][0].stamp == pytest.approx(sim.sim_time)
+    assert sim.scans[0][0].ranges[90] == pytest.approx(7.88)
