@@ -48,7 +48,7 @@ Usage::
     result = caster.cast(origins_xy, angles, max_ranges=5.6)       # (N, 2), (N,), float or (N,)
     result.ranges, result.hit_cell, result.hit_robot
 
-    robots = RobotLayer(caster.windows, caster.resolution, caster.origin_xy)   # once per caster; every step:
+    robots = caster.robot_layer()                                   # once per caster; every step:
     robots.update(rows, cols, ids, visible=robot_seen_at_this_height)   # the robots' cells
     result = caster.cast(origins_xy, angles, ranges, owners=ray_robot_ids, robots=robots)
 
@@ -129,6 +129,12 @@ class GridRayCaster:
         self._origin_col = np.array(self.origin_xy)[:, None]
         self._size_col = np.array([[self.width], [self.height]], dtype=np.float64)
         self._squares = quadrant_square_fields(self._windows.padded).ravel()
+
+    kernels = "numpy"
+
+    def robot_layer(self) -> RobotLayer:
+        """An empty robot layer for this caster's grid."""
+        return RobotLayer(self._windows, self.resolution, self.origin_xy)
 
     @property
     def windows(self) -> RayWindows:

@@ -42,6 +42,22 @@ _TWO_PI = 2.0 * np.pi
 _SCAN_STRIDE = 8.0
 
 
+def visible_cells(
+    cell_rows: np.ndarray, cell_cols: np.ndarray, robot_ids: np.ndarray, shape: tuple[int, int],
+    visible: np.ndarray | None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The (rows, cols, ids) int64 entries that lie on the grid and belong to a visible robot."""
+    rows = np.asarray(cell_rows, dtype=np.int64).ravel()
+    cols = np.asarray(cell_cols, dtype=np.int64).ravel()
+    ids = np.asarray(robot_ids, dtype=np.int64).ravel()
+    keep = (rows >= 0) & (rows < shape[0]) & (cols >= 0) & (cols < shape[1]) & (ids >= 0)
+    if visible is not None:
+        vis = np.asarray(visible, dtype=bool)
+        keep &= ids < vis.size
+        keep[keep] = vis[ids[keep]]
+    return rows[keep], cols[keep], ids[keep]
+
+
 class RobotLayer:
     """The robots one caster's rays can hit, rebuilt every step (one layer per ray height).
 
@@ -72,15 +88,7 @@ class RobotLayer:
         visible: np.ndarray | None = None,
     ) -> None:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
-        rows = np.asarray(cell_rows, dtype=np.int64).ravel()
-        cols = np.asarray(cell_cols, dtype=np.int64).ravel()
-        ids = np.asarray(robot_ids, dtype=np.int64).ravel()
-        keep = (rows >= 0) & (rows < self._height) & (cols >= 0) & (cols < self._width) & (ids >= 0)
-        if visible is not None:
-            vis = np.asarray(visible, dtype=bool)
-            keep &= ids < vis.size
-            keep[keep] = vis[ids[keep]]
-        rows, cols, ids = rows[keep], cols[keep], ids[keep]
+        rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, (self._height, self._width), visible)
         self._ids[self._written] = -1
         flat = (rows + PAD) * self._windows.wp + (cols + PAD)
         self._ids[flat] = ids

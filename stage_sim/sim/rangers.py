@@ -13,14 +13,19 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
+from stage_sim.sensing.kernels import make_caster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
 from stage_sim.sim.collision import Bodies, GridFrame, place
 from stage_sim.sim.robots import RobotSpec
+
+if TYPE_CHECKING:
+    from stage_sim.sensing.fast_caster import NumbaRayCaster, RobotCells
 
 
 @dataclass
@@ -37,8 +42,8 @@ class _HeightGroup:
     """The rays cast at one height, with the static layer and the robots visible there."""
 
     rays: np.ndarray
-    caster: GridRayCaster
-    robots: RobotLayer
+    caster: GridRayCaster | NumbaRayCaster
+    robots: RobotLayer | RobotCells
     intensity: np.ndarray
     robot_visible: np.ndarray
     robot_return: np.ndarray
@@ -47,7 +52,10 @@ class _HeightGroup:
 class RangerSensing:
     """Holds the beam tables of all rangers and produces their scans."""
 
-    def __init__(self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame) -> None:
+    def __init__(
+        self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame, kernels: str = "numpy",
+        threads: int = 1,
+    ) -> None:
         self._bodies = bodies
         self._grid = grid
         self._rangers = [(robot.index, ranger) for robot in robots for ranger in robot.rangers]
@@ -69,7 +77,7 @@ class RangerSensing:
         self._noise = np.array([r.sensor.noise for _, r in self._rangers]).reshape(-1, 3)
         self._interval_us = np.array([round(r.update_interval * 1e6) for _, r in self._rangers], dtype=np.int64)
         ray_height = np.concatenate(heights) if heights else np.zeros(0)
-        self._groups = self._height_groups(robots, static, ray_height)
+        self._groups = self._height_groups(robots, static, ray_height, kernels, threads)
         self._slices = self._ranger_slices()
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
@@ -161,17 +169,19 @@ class RangerSensing:
         out[rays] = np.where(hit, ranges[rays] + ranges[rays] * prop * u_range + gauss, ranges[rays])
         return out
 
-    def _height_groups(self, robots: list[RobotSpec], static: StaticRaster, ray_height: np.ndarray) -> list:
+    def _height_groups(
+        self, robots: list[RobotSpec], static: StaticRaster, ray_height: np.ndarray, kernels: str, threads: int
+    ) -> list:
         groups = []
         returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
         for height in np.unique(ray_height):
             occupied, intensity = static.sensing_layer(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
-            caster = GridRayCaster(occupied, static.resolution, static.origin_xy)
+            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
             groups.append(_HeightGroup(
                 rays=np.flatnonzero(ray_height == height),
                 caster=caster,
-                robots=RobotLayer(caster.windows, caster.resolution, caster.origin_xy),
+                robots=caster.robot_layer(),
                 intensity=intensity,
                 robot_visible=visible,
                 robot_return=returns,

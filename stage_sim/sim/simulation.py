@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster, build_static_raster
+from stage_sim.sensing.kernels import resolve_kernels, resolve_threads
 from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import draw_odom_errors, integrate_odometry, relative_pose
@@ -46,8 +47,16 @@ class RobotState:
 class Simulation:
     """A Stage world in motion: robots, their odometry and their lasers."""
 
-    def __init__(self, description: WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0) -> None:
+    def __init__(
+        self, description: WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0,
+        kernels: str | None = None, threads: int | None = None,
+    ) -> None:
+        """``kernels``: "numba" or "numpy" (identical results; default numba, ``$STAGE_SIM_KERNELS``);
+        ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
+        ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.sensing.kernels`."""
         self.description = description
+        self.kernels = resolve_kernels(kernels)
+        self.threads = resolve_threads(threads)
         self.warnings: list[WorldWarning] = list(description.warnings)
         self.robots: list[RobotSpec] = build_robots(description, self.warnings)
         self.interval_us = max(1, round(description.settings.interval_sim * MICROSECONDS))
@@ -57,7 +66,7 @@ class Simulation:
         grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy)
         self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
         self._collision = self._make_collision_checker(grid)
-        self._sensing = RangerSensing(self.robots, self.static, self._bodies, grid)
+        self._sensing = RangerSensing(self.robots, self.static, self._bodies, grid, self.kernels, self.threads)
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
         self._drives = np.array([r.drive_code for r in self.robots], dtype=np.int64)
@@ -75,14 +84,15 @@ class Simulation:
 
     @classmethod
     def from_world(
-        cls, world: str | Path | WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0
+        cls, world: str | Path | WorldDescription, seed: int | None = None, watchdog_timeout: float = 0.0,
+        kernels: str | None = None, threads: int | None = None,
     ) -> Simulation:
         """A simulation of a world file (path) or of an already loaded description."""
         if not isinstance(world, WorldDescription):
             from stage_sim.worldfile.loader import load_world
 
             world = load_world(world)
-        return cls(world, seed=seed, watchdog_timeout=watchdog_timeout)
+        return cls(world, seed=seed, watchdog_timeout=watchdog_timeout, kernels=kernels, threads=threads)
 
     # -- lifecycle -------------------------------------------------------------------------------------
 

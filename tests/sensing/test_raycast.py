@@ -18,8 +18,7 @@ import numpy as np
 import pytest
 
 from stage_sim.maps.polygon_raster import fill_polygon
-from stage_sim.sensing.raycast import GridRayCaster
-from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
+from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
 
 RES = 0.05
 ORIGIN = (-1.25, 0.75)
@@ -145,20 +144,20 @@ def assert_matches_traversal(result, occupied, res, origin, xy, angles, rmax, ow
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_random_rays_match_the_traversal_cell_for_cell(seed):
+def test_random_rays_match_the_traversal_cell_for_cell(seed, new_caster):
     rng = np.random.default_rng(seed)
     occ = random_map(rng)
-    caster = GridRayCaster(occ, RES, ORIGIN)
+    caster = new_caster(occ, RES, ORIGIN)
     xy, angles, rmax = random_rays(rng, occ, 1500)
     result = caster.cast(xy, angles, rmax)
     assert_matches_traversal(result, occ, RES, ORIGIN, xy, angles, rmax)
     assert 0.2 < np.mean(result.hit_cell >= 0) < 0.98  # both hits and misses are exercised
 
 
-def test_small_and_large_batches_agree():
+def test_small_and_large_batches_agree(new_caster):
     rng = np.random.default_rng(9)
     occ = random_map(rng, 120, 150, 120)
-    caster = GridRayCaster(occ, RES, ORIGIN)
+    caster = new_caster(occ, RES, ORIGIN)
     xy, angles, rmax = random_rays(rng, occ, 20000, margin=0.0)
     big = caster.cast(xy, angles, rmax)
     for a in range(0, 20000, 2500):
@@ -170,10 +169,10 @@ def test_small_and_large_batches_agree():
     assert_matches_traversal(sub, occ, RES, ORIGIN, xy[pick], angles[pick], rmax[pick])
 
 
-def test_brute_force_sampling_agrees_except_on_provably_skipped_corners():
+def test_brute_force_sampling_agrees_except_on_provably_skipped_corners(new_caster):
     rng = np.random.default_rng(5)
     occ = random_map(rng)
-    caster = GridRayCaster(occ, RES, ORIGIN)
+    caster = new_caster(occ, RES, ORIGIN)
     xy, angles, rmax = random_rays(rng, occ, 400, margin=0.0)
     result = caster.cast(xy, angles, rmax)
     skipped = 0
@@ -190,11 +189,11 @@ def test_brute_force_sampling_agrees_except_on_provably_skipped_corners():
     assert skipped <= angles.size // 50, f"{skipped} corner-clipped rays"
 
 
-def test_rays_along_grid_lines_in_all_four_directions():
+def test_rays_along_grid_lines_in_all_four_directions(new_caster):
     occ = np.zeros((20, 20), dtype=bool)
     occ[:, 15] = occ[:, 3] = True  # walls at columns 3 and 15
     occ[15, :] = occ[2, :] = True  # and rows 2 and 15
-    caster = GridRayCaster(occ, 1.0, (0.0, 0.0))
+    caster = new_caster(occ, 1.0, (0.0, 0.0))
     # Origin exactly on grid lines (x = 8, y = 9): it belongs to cell (9, 8).
     xy = np.array([[8.0, 9.0]] * 4 + [[8.5, 9.5]] * 4)
     angles = np.array([0.0, math.pi / 2, math.pi, -math.pi / 2] * 2)
@@ -207,11 +206,11 @@ def test_rays_along_grid_lines_in_all_four_directions():
     assert_matches_traversal(result, occ, 1.0, (0.0, 0.0), xy, angles, 50.0)
 
 
-def test_grazing_rays_and_exact_corners():
+def test_grazing_rays_and_exact_corners(new_caster):
     occ = np.zeros((30, 30), dtype=bool)
     occ[10, 5:25] = True  # a horizontal wall
     occ[20, 20] = True  # a lone cell for corner hits
-    caster = GridRayCaster(occ, 0.02, (0.0, 0.0))
+    caster = new_caster(occ, 0.02, (0.0, 0.0))
     rng = np.random.default_rng(3)
     # Nearly parallel to the wall, just above it: tiny slopes either way.
     n = 400
@@ -225,19 +224,19 @@ def test_grazing_rays_and_exact_corners():
     assert_matches_traversal(result, occ, 0.02, (0.0, 0.0), xy, angles, 1.0)
 
 
-def test_origin_inside_an_obstacle_gives_zero():
+def test_origin_inside_an_obstacle_gives_zero(new_caster):
     occ = np.zeros((10, 10), dtype=bool)
     occ[4, 4] = True
-    caster = GridRayCaster(occ, 0.1, (0.0, 0.0))
+    caster = new_caster(occ, 0.1, (0.0, 0.0))
     result = caster.cast([[0.45, 0.45], [0.4, 0.4]], [1.0, -2.0], 5.0)
     assert list(result.ranges) == [0.0, 0.0]
     assert list(result.hit_cell) == [44, 44]
 
 
-def test_misses_return_the_max_range_exactly():
+def test_misses_return_the_max_range_exactly(new_caster):
     occ = np.zeros((10, 10), dtype=bool)
     occ[5, 9] = True
-    caster = GridRayCaster(occ, 0.1, (0.0, 0.0))
+    caster = new_caster(occ, 0.1, (0.0, 0.0))
     rmax = np.array([0.3, 2.0 / 3.0, 50.0, 0.35])
     # Short range before the wall; leaving the map; the wall is exactly 0.4 m away.
     result = caster.cast([[0.5, 0.55], [0.5, 0.55], [0.5, 0.55], [0.5, 0.55]], [0.0, math.pi, 2.0, 0.0], rmax)
@@ -246,10 +245,10 @@ def test_misses_return_the_max_range_exactly():
     assert caster.cast([[0.5, 0.55]], [0.0], 0.41).ranges[0] == pytest.approx(0.4, abs=1e-12)
 
 
-def test_origins_outside_the_grid_enter_it():
+def test_origins_outside_the_grid_enter_it(new_caster):
     occ = np.zeros((10, 10), dtype=bool)
     occ[:, 5] = True
-    caster = GridRayCaster(occ, 1.0, (0.0, 0.0))
+    caster = new_caster(occ, 1.0, (0.0, 0.0))
     result = caster.cast([[-3.5, 2.5], [12.0, 7.2], [-3.0, -3.0]], [0.0, math.pi, math.pi / 4], 20.0)
     assert result.ranges[:2] == pytest.approx([8.5, 6.0], abs=1e-12)
     assert_matches_traversal(
@@ -263,10 +262,10 @@ def test_origins_outside_the_grid_enter_it():
     )
 
 
-def test_angles_beyond_pi_wrap():
+def test_angles_beyond_pi_wrap(new_caster):
     rng = np.random.default_rng(2)
     occ = random_map(rng)
-    caster = GridRayCaster(occ, RES, ORIGIN)
+    caster = new_caster(occ, RES, ORIGIN)
     xy, angles, rmax = random_rays(rng, occ, 300, margin=0.0)
     base = caster.cast(xy, angles, rmax)
     for turns in (-2, 1, 3):
@@ -276,23 +275,23 @@ def test_angles_beyond_pi_wrap():
         assert_matches_traversal(turned, occ, RES, ORIGIN, xy, angles + 2 * math.pi * turns, rmax)
 
 
-def test_two_heights_see_their_own_layers():
+def test_two_heights_see_their_own_layers(new_caster):
     low = np.zeros((20, 20), dtype=bool)
     low[:, 8] = True  # a low box: only the low layer has it
     high = np.zeros((20, 20), dtype=bool)
     high[:, 14] = True  # a wall seen by both
     low |= high
-    casters = {0.1: GridRayCaster(low, 0.1, (0.0, 0.0)), 0.3: GridRayCaster(high, 0.1, (0.0, 0.0))}
+    casters = {0.1: new_caster(low, 0.1, (0.0, 0.0)), 0.3: new_caster(high, 0.1, (0.0, 0.0))}
     xy = np.array([[0.25, 1.05]] * 2)
     ranges = {z: c.cast(xy, [0.0, 0.0], 5.0).ranges[0] for z, c in casters.items()}
     assert ranges[0.1] == pytest.approx(0.55, abs=1e-12)
     assert ranges[0.3] == pytest.approx(1.15, abs=1e-12)
 
 
-def _robot_world():
+def _robot_world(new_caster):
     occ = np.zeros((40, 60), dtype=bool)
     occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
-    caster = GridRayCaster(occ, 0.05, (0.0, 0.0))
+    caster = new_caster(occ, 0.05, (0.0, 0.0))
     squares = np.array(
         [
             [[x - 0.2, y - 0.2], [x + 0.2, y - 0.2], [x + 0.2, y + 0.2], [x - 0.2, y + 0.2]]
@@ -303,9 +302,9 @@ def _robot_world():
     return occ, caster, rows, cols, ids
 
 
-def test_robot_layer_hits_other_robots_and_passes_through_its_own():
-    occ, caster, rows, cols, ids = _robot_world()
-    layer = RobotLayer(caster.windows, caster.resolution, caster.origin_xy)
+def test_robot_layer_hits_other_robots_and_passes_through_its_own(new_caster):
+    occ, caster, rows, cols, ids = _robot_world(new_caster)
+    layer = caster.robot_layer()
     layer.update(rows, cols, ids)
     xy = np.array([[0.6, 1.0], [1.6, 1.0], [1.6, 1.0], [0.6, 1.0]])
     angles = np.array([0.0, math.pi, math.pi / 2, math.pi])
@@ -319,9 +318,9 @@ def test_robot_layer_hits_other_robots_and_passes_through_its_own():
     assert_matches_traversal(result, occ, 0.05, (0.0, 0.0), xy, angles, 10.0, owners, grid)
 
 
-def test_robot_layer_invisible_robots_shared_cells_and_random_rays():
-    occ, caster, rows, cols, ids = _robot_world()
-    layer = RobotLayer(caster.windows, caster.resolution, caster.origin_xy)
+def test_robot_layer_invisible_robots_shared_cells_and_random_rays(new_caster):
+    occ, caster, rows, cols, ids = _robot_world(new_caster)
+    layer = caster.robot_layer()
     visible = np.array([True, False, True, True])
     # Robot 3 also claims a cell of robot 2: that shared cell blocks everybody.
     shared = (rows[ids == 2][0], cols[ids == 2][0])
