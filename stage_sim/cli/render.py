@@ -9,6 +9,7 @@ from typing import Any
 
 from stage_sim.cli.arguments import count, image_path, positive, resolve_world
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
+from stage_sim.sensing.kernels import add_kernel_arguments
 
 
 def run(args: argparse.Namespace) -> int:
@@ -16,7 +17,7 @@ def run(args: argparse.Namespace) -> int:
     from stage_sim.sim.simulation import Simulation
 
     world = resolve_world(args.world)
-    sim = Simulation.from_world(world, seed=args.seed)
+    sim = Simulation.from_world(world, seed=args.seed, kernels=args.kernels, threads=args.threads)
     output = args.output or Path(f"{world.stem}.png")
     try:
         recorder = Recorder(
@@ -52,6 +53,7 @@ def add_command(subparsers: Any) -> None:
     parser.add_argument("--no-lasers", action="store_true", help="do not draw the laser rays")
     parser.add_argument("--grid", action="store_true", help="draw a 1 m grid")
     parser.add_argument("--seed", type=int, default=0, help="simulation (and wanderer) seed (default: 0)")
+    add_kernel_arguments(parser)
     parser.add_argument("--steps", type=count, default=0, help="steps to simulate first (default: 0)")
     parser.add_argument(
         "--controller", choices=sorted(CONTROLLERS), default="straight",

@@ -32,6 +32,7 @@ from tf2_msgs.msg import TFMessage
 
 from stage_sim.ros import conversions
 from stage_sim.ros.names import RobotNames, robot_names
+from stage_sim.sensing.kernels import resolve_threads
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.loader import load_world
@@ -69,10 +70,12 @@ class StageRos(Node):
 
     def __init__(
         self, world: str | Path | None = None, *, speedup: float | None = None, seed: int | None = None,
-        use_model_names: bool | None = None, node_name: str = "stageros", autostep: bool = True, **kwargs,
+        use_model_names: bool | None = None, node_name: str = "stageros", autostep: bool = True,
+        kernels: str | None = None, threads: int | None = None, **kwargs,
     ) -> None:
         """Load the world and advertise everything; ``autostep=False`` leaves stepping to the caller
-        (:meth:`step_once`), for tests and programs that drive the simulation themselves."""
+        (:meth:`step_once`), for tests and programs that drive the simulation themselves. ``threads``
+        defaults to 1 in real time and to all cores with ``speedup <= 0``."""
         super().__init__(node_name, **kwargs)
         world_param = self.declare_parameter("world_file", str(world) if world is not None else "").value
         if not world_param:
@@ -87,7 +90,9 @@ class StageRos(Node):
         self.publish_map = bool(self.declare_parameter("publish_map", False).value)
         stamped = bool(self.declare_parameter("use_stamped_velocity", False).value)
 
-        self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog)
+        threads = resolve_threads(threads, default=0 if self.speedup <= 0 else 1)
+        self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog,
+                              kernels=kernels, threads=threads)
         for warning in self.sim.warnings:
             self.get_logger().warning(str(warning))
         robots = self.sim.robots

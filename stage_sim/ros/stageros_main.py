@@ -1,4 +1,4 @@
-"""``stageros [-g] [-u] [--speedup X] [--seed N] WORLD [--ros-args ...]``: run the simulator node.
+"""``stageros [-g] [-u] [--speedup X] [--seed N] [--kernels K] [--threads N] WORLD [--ros-args ...]``: run the node.
 
 A broken world prints ``file:line:column: ...`` and exits with status 2 (no traceback); Ctrl-C and the
 world's ``quit_time`` end the node cleanly with status 0.
@@ -18,6 +18,7 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import remove_ros_args
 
 from stage_sim.ros.recording import add_record_arguments, recording
+from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.worldfile.bundled import bundled_worlds
 from stage_sim.worldfile.errors import WorldError
 
@@ -33,6 +34,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--speedup", type=float, default=None,
                         help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
     parser.add_argument("--seed", type=int, default=None, help="seed for drawn odometry errors and sensor noise")
+    add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
     add_record_arguments(parser)
     parser.add_argument("world", nargs="?", default=None,
                         help="a .world file, or a bundled world's name (else the 'world_file' parameter)")
@@ -48,7 +50,8 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv)
     node = None
     try:
-        node = StageRos(args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None)
+        node = StageRos(args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None,
+                        kernels=args.kernels, threads=args.threads)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         with recording(node, args, "stageros"):

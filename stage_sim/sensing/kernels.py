@@ -18,6 +18,7 @@ first compilation logs "compiling simulation kernels, once"; ``make setup`` runs
 
 from __future__ import annotations
 
+import argparse
 import logging
 import os
 import warnings
@@ -72,6 +73,15 @@ def numba_available() -> bool:
         warnings.warn(f"numba unavailable ({error}); using the numpy kernels", RuntimeWarning, stacklevel=3)
         return False
     return True
+
+
+def add_kernel_arguments(parser: argparse.ArgumentParser, threads_default: str = "1") -> None:
+    """``--kernels`` and ``--threads``, the same on every command that simulates."""
+    parser.add_argument("--kernels", choices=KERNELS, default=None,
+                        help=f"hot-path implementation, identical results (default: ${KERNELS_ENV} or numba)")
+    parser.add_argument("--threads", type=int, default=None,
+                        help=f"kernel threads, 0 = all cores, identical results (default: ${THREADS_ENV} or "
+                             f"{threads_default})")
 
 
 def make_caster(
