@@ -28,14 +28,15 @@ class RobotCells:
     """Robot footprints on one layer for the compiled caster.
 
     Same meaning as :class:`~stage_sim.sensing.robot_layer.RobotLayer`: an id per cell, :data:`SEVERAL_ROBOTS`
-    where two robots touch; block counts let rays skip robot-free space.
+    where two robots touch; per block, which robot is there (if only one) lets rays skip robot-free space.
     """
 
     def __init__(self, shape: tuple[int, int]) -> None:
         self.shape = shape
         self.grid = np.full(shape, -1, dtype=np.int32)
-        self.fine = _block_grid(shape, traversal.FINE)
-        self.coarse = _block_grid(shape, traversal.COARSE)
+        size = 1 << traversal.BLOCK
+        self.blocks = np.full((-(-shape[0] // size), -(-shape[1] // size)), -1, dtype=np.int32)
+        self.block_squares = traversal.square_fields(self.blocks != -1)
         self._written = np.empty(0, dtype=np.int64)
         self.active = False
 
@@ -49,8 +50,8 @@ class RobotCells:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         flat = rows * self.shape[1] + cols
-        traversal.write_robot_cells(self.grid, self.fine, self.coarse, self._written, flat, ids.astype(np.int32),
-                                    SEVERAL_ROBOTS)
+        traversal.write_robot_cells(self.grid, self.blocks, self._written, flat, ids.astype(np.int32), SEVERAL_ROBOTS)
+        self.block_squares = traversal.square_fields(self.blocks != -1)
         self._written = flat
         self.active = flat.size > 0
 
@@ -102,7 +103,7 @@ class NumbaRayCaster:
         t_hit = np.empty(n)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
-        args = (self._squares, layer.grid, layer.active, layer.fine, layer.coarse, u, v, dx, dy, reach, own,
+        args = (self._squares, layer.grid, layer.active, layer.blocks, layer.block_squares, u, v, dx, dy, reach, own,
                 t_hit, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
@@ -112,7 +113,3 @@ class NumbaRayCaster:
         ranges = np.where(cell >= 0, t_hit * self.resolution, rmax)
         return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
 
-
-def _block_grid(shape: tuple[int, int], shift: int) -> np.ndarray:
-    size = 1 << shift
-    return np.zeros((-(-shape[0] // size), -(-shape[1] // size)), dtype=np.int32)

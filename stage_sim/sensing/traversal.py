@@ -10,8 +10,10 @@ Free space is skipped without changing any answer. From the current cell the ray
 
 * the largest free square with the cell as its corner in the ray's quadrant
   (:func:`square_fields`, one uint8 per cell and quadrant; 0 marks an occupied cell);
-* intersected, when robots are about, with the robot-free block of 64 or 8 cells around the cell
-  (counts in :class:`~stage_sim.sensing.fast_caster.RobotCells`);
+* intersected, when robots are about, with the largest square of robot-free 8-cell blocks from the
+  cell's block (the same square fields, on blocks), or else with the cell's own block if no robot but the
+  ray's own is there (a ray never sees its own robot)
+  (:class:`~stage_sim.sensing.fast_caster.RobotCells`);
 * outside the grid, the half-plane beyond the grid edge (outside is free).
 
 The jump lands exactly where the walk would: the box is left through the line with the earlier crossing
@@ -27,8 +29,8 @@ import math
 import numba
 import numpy as np
 
-#: Robot occupancy blocks: 2**FINE and 2**COARSE cells a side.
-FINE, COARSE = 3, 6
+#: Robot occupancy blocks: 2**BLOCK cells a side.
+BLOCK = 3
 #: Largest free-square side stored (uint8).
 SQUARE_CAP = 255
 #: A line "at infinity" for the half-planes outside the grid (cells, exact in float64).
@@ -46,7 +48,7 @@ def _x_first(tx: float, ty: float, x_major: bool) -> bool:
 
 
 @numba.njit(**_JIT)
-def cast_ray(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner):
+def cast_ray(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner):
     """(entry time in cells or inf, flat cell or -1, robot id or -1) of one ray from cell coordinates (u, v)."""
     h, w = squares.shape[1], squares.shape[2]
     idx = 1.0 / dx
@@ -56,26 +58,29 @@ def cast_ray(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, own
     sy = 1 if dy >= 0 else -1
     ax = 1 if dx >= 0 else 0
     ay = 1 if dy >= 0 else 0
-    square = squares[(1 - ax) + 2 * (1 - ay)]
+    quadrant = (1 - ax) + 2 * (1 - ay)
+    square = squares[quadrant]
     if not (abs(u) < 1e15 and abs(v) < 1e15):  # also NaN
         return math.inf, -1, -1
     ix = math.floor(u)
     iy = math.floor(v)
     t = 0.0
-    shift = 0
     while True:
         if 0 <= ix < w and 0 <= iy < h:
             k = np.int64(square[iy, ix])
-            if use_robots:
-                if coarse[iy >> COARSE, ix >> COARSE] == 0:
-                    shift = COARSE
-                elif fine[iy >> FINE, ix >> FINE] == 0:
-                    shift = FINE
-                else:
-                    rid = robots[iy, ix]
-                    if rid != -1 and rid != owner:
-                        return t, iy * w + ix, rid
-                    k = min(k, 1)
+            if use_robots:  # a square of robot-free blocks, or a block with no robot but the ray's own
+                bx = ix >> BLOCK
+                by = iy >> BLOCK
+                side = np.int64(block_squares[quadrant, by, bx])
+                if side == 0:
+                    block = blocks[by, bx]
+                    if block == -1 or block == owner:
+                        side = 1
+                    else:
+                        rid = robots[iy, ix]
+                        if rid != -1 and rid != owner:
+                            return t, iy * w + ix, rid
+                        k = min(k, 1)
             if k == 0:
                 return t, iy * w + ix, -1
             if k == 1:  # next to an obstacle: one plain step
@@ -93,10 +98,10 @@ def cast_ray(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, own
             lx = ix + sx * k + (1 - ax)
             ly = iy + sy * k + (1 - ay)
             if use_robots:
-                bx = ((ix >> shift) + ax) << shift
-                by = ((iy >> shift) + ay) << shift
-                lx = min(lx, bx) if sx > 0 else max(lx, bx)
-                ly = min(ly, by) if sy > 0 else max(ly, by)
+                blx = (bx + sx * (side - 1) + ax) << BLOCK
+                bly = (by + sy * (side - 1) + ay) << BLOCK
+                lx = min(lx, blx) if sx > 0 else max(lx, blx)
+                ly = min(ly, bly) if sy > 0 else max(ly, bly)
         elif ix < 0 or ix >= w:
             if (ix < 0) == (sx < 0) or dx == 0.0:
                 return math.inf, -1, -1  # moving away from the grid
@@ -148,24 +153,24 @@ def _reached(p, inv, d, t_exit, i, line, s, a, x_major, other_is_y):
 
 
 @numba.njit(**_JIT)
-def _cast_range(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner, t, cell, rid, a, b):
+def _cast_range(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner, t, cell, rid, a, b):
     for i in range(a, b):
-        t[i], cell[i], rid[i] = cast_ray(squares, robots, use_robots, fine, coarse, u[i], v[i], dx[i], dy[i],
+        t[i], cell[i], rid[i] = cast_ray(squares, robots, use_robots, blocks, block_squares, u[i], v[i], dx[i], dy[i],
                                          reach[i], owner[i])
 
 
 @numba.njit(**_JIT)
-def cast_serial(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner, t, cell, rid):
+def cast_serial(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner, t, cell, rid):
     """Every ray in order, on the calling thread."""
-    _cast_range(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner, t, cell, rid, 0, u.size)
+    _cast_range(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner, t, cell, rid, 0, u.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner, t, cell, rid):
+def cast_parallel(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner, t, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = u.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(squares, robots, use_robots, fine, coarse, u, v, dx, dy, reach, owner, t, cell, rid,
+        _cast_range(squares, robots, use_robots, blocks, block_squares, u, v, dx, dy, reach, owner, t, cell, rid,
                     k * _CHUNK, min(n, (k + 1) * _CHUNK))
 
 
@@ -202,25 +207,22 @@ def square_fields(occupied):
 
 
 @numba.njit(**_JIT)
-def write_robot_cells(grid, fine, coarse, old, flat, ids, several):
+def write_robot_cells(grid, blocks, old, flat, ids, several):
     """Clear the cells ``old`` of ``grid``, then write robot ``ids[i]`` into cell ``flat[i]``.
 
-    A cell written by two robots holds ``several``; ``fine``/``coarse`` count the robot cells per block.
+    A cell written by two robots holds ``several``. ``blocks`` says per block which robots have cells
+    there: -1 none, ``several`` two or more, else the one robot's id.
     """
     w = grid.shape[1]
     g = grid.ravel()
     for f in old:
-        if g[f] != -1:
-            g[f] = -1
-            r, c = f // w, f % w
-            fine[r >> FINE, c >> FINE] -= 1
-            coarse[r >> COARSE, c >> COARSE] -= 1
+        g[f] = -1
+        r, c = f // w, f % w
+        blocks[r >> BLOCK, c >> BLOCK] = -1
     for i in range(flat.size):
         f = flat[i]
-        if g[f] == -1:
-            g[f] = ids[i]
-            r, c = f // w, f % w
-            fine[r >> FINE, c >> FINE] += 1
-            coarse[r >> COARSE, c >> COARSE] += 1
-        elif g[f] != ids[i]:
-            g[f] = several
+        robot = ids[i]
+        g[f] = robot if g[f] == -1 or g[f] == robot else several
+        r, c = f // w, f % w
+        b = blocks[r >> BLOCK, c >> BLOCK]
+        blocks[r >> BLOCK, c >> BLOCK] = robot if b == -1 or b == robot else several
