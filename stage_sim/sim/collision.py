@@ -51,7 +51,7 @@ class Bodies:
 
     def point_cells(self, poses: np.ndarray, grid: GridFrame) -> np.ndarray:
         """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
-        return point_cells(place(self.points, poses[self.owner]), grid.resolution, grid.origin_xy, grid.shape)
+        return grid.body_cells(self.points, self.owner, poses)
 
 
 @dataclass(frozen=True)
@@ -61,6 +61,18 @@ class GridFrame:
     shape: tuple[int, int]
     resolution: float
     origin_xy: tuple[float, float]
+    kernels: str = "numpy"
+
+    def body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
+        if self.kernels == "numpy":
+            return point_cells(place(points, poses[pose_index]), self.resolution, self.origin_xy, self.shape)
+        from stage_sim.sim.collision_kernels import body_cells
+
+        out = np.empty(len(points), dtype=np.int64)
+        body_cells(points, pose_index, poses[:, 0].copy(), poses[:, 1].copy(), np.cos(poses[:, 2]),
+                   np.sin(poses[:, 2]), self.resolution, *self.origin_xy, *self.shape, out)
+        return out
 
 
 class CollisionChecker:
@@ -110,9 +122,6 @@ class CollisionChecker:
             touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
         return touching | self._robot_conflicts(poses)
 
-    def _cells(self, points: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        return point_cells(place(points, poses), self.grid.resolution, self.grid.origin_xy, self.grid.shape)
-
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
         counts = self._point_count[robots]
@@ -131,7 +140,7 @@ class CollisionChecker:
             substeps, substeps)
         probes = integrate(poses[robot], velocities[robot] * fraction[:, None], dt)
         point_index, probe = self._points_of(robot)
-        cells = self._cells(self.bodies.points[point_index], probes[probe])
+        cells = self.grid.body_cells(self.bodies.points[point_index], probe, probes)
         point_robot = robot[probe]
         layer_index = self._layer_of_robot[point_robot]
         hit = np.zeros(len(cells), dtype=bool)
@@ -148,7 +157,12 @@ class CollisionChecker:
             return conflict
         point_index, entry = self._points_of(colliding)
         owner = colliding[entry]
-        cells = self._cells(self.bodies.points[point_index], poses[owner])
+        cells = self.grid.body_cells(self.bodies.points[point_index], owner, poses)
+        if self.grid.kernels == "numba":
+            from stage_sim.sim.collision_kernels import owner_clashes
+
+            owner_clashes(cells, owner, self._owner_grid, conflict)
+            return conflict
         keep = cells >= 0
         cells, owner = cells[keep], owner[keep]
         grid = self._owner_grid

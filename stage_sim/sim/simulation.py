@@ -63,7 +63,7 @@ class Simulation:
         self.watchdog_timeout = watchdog_timeout
         starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
         self.static: StaticRaster = build_static_raster(description, starts)
-        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy)
+        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.kernels)
         self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
         self._collision = self._make_collision_checker(grid)
         self._sensing = RangerSensing(self.robots, self.static, self._bodies, grid, self.kernels, self.threads)
