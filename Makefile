@@ -39,6 +39,8 @@ $(VENV)/.package.stamp: $(VENV)/.tf2_msgs.stamp setup.py setup.cfg package.xml p
 	@echo "[setup] installing stage_sim (editable)"
 	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . || { \
 	  echo "make setup: step 'stage_sim' failed: 'pip install -e .' did not work; see the error above" >&2; exit 1; }
+	@echo "[setup] compiling the numba kernels into their cache (once)"
+	@$(PY) -m stage_sim.sim.warm_up || { echo "make setup: step 'kernels' failed: see the error above" >&2; exit 1; }
 	@touch $@
 
 run: setup

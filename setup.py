@@ -21,7 +21,7 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
-    install_requires=["setuptools", "numpy", "pyyaml", "pillow"],
+    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow"],
     extras_require={"test": ["pytest"]},
     zip_safe=True,
     entry_points={
