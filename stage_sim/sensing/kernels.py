@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import sys
 import warnings
 from functools import cache
 from pathlib import Path
@@ -36,7 +37,6 @@ KERNELS = ("numba", "numpy")
 KERNELS_ENV = "STAGE_SIM_KERNELS"
 THREADS_ENV = "STAGE_SIM_THREADS"
 _PACKAGE = Path(__file__).resolve().parents[1]
-_USER_CACHE = Path.home() / ".cache" / "stage_sim"
 
 log = logging.getLogger("stage_sim")
 
@@ -123,10 +123,9 @@ def _configure_cache_dir() -> None:
     """Point numba's cache at ``~/.cache/stage_sim`` when the package folder cannot hold it."""
     if os.environ.get("NUMBA_CACHE_DIR") or os.access(_PACKAGE, os.W_OK):
         return
-    _USER_CACHE.mkdir(parents=True, exist_ok=True)
-    os.environ["NUMBA_CACHE_DIR"] = str(_USER_CACHE)
-    import sys
-
+    user_cache = Path.home() / ".cache" / "stage_sim"
+    user_cache.mkdir(parents=True, exist_ok=True)
+    os.environ["NUMBA_CACHE_DIR"] = str(user_cache)
     if "numba" in sys.modules:  # imported before us: tell its config too
-        sys.modules["numba"].config.CACHE_DIR = str(_USER_CACHE)
+        sys.modules["numba"].config.CACHE_DIR = str(user_cache)
 
