@@ -72,7 +72,7 @@ def main() -> None:
 
     with tempfile.TemporaryDirectory() as tmp:
         hundred = Path(tmp) / "hundred.world"
-        hundred.write_text(world_text(100, 240, 1))
+        hundred.write_text(world_text(100, 240, 240.0, 5.6, 1))
         print(json.dumps(measure("as fast as possible", hundred, 100, "0", args.seconds)), flush=True)
 
 

@@ -1,0 +1,68 @@
+"""Start-up: wall seconds from starting ``stageros rooms.world`` to its first /base_scan, cold and warm cache.
+
+Run with the venv's python: ``.venv/bin/python benchmarks/startup.py [--runs N]``. Prints one JSON object
+per line: ``case`` ("cold cache": numba compiles every kernel into an empty cache folder; "warm cache":
+the same folder, now filled; "numpy kernels": no numba at all), ``run``, ``first_scan_s``. The subscriber
+lives in this process and is up before stageros starts, so the time is the node's own.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import QoSProfile
+from sensor_msgs.msg import LaserScan
+
+REPO = Path(__file__).resolve().parents[1]
+STAGEROS = Path(sys.executable).with_name("stageros")
+
+
+def first_scan(env: dict[str, str], timeout: float = 120.0) -> float:
+    """Seconds from launching stageros until this process receives its first /base_scan."""
+    rclpy.init()
+    node = rclpy.create_node("startup_benchmark")
+    got: list[float] = []
+    node.create_subscription(LaserScan, "/base_scan", lambda _: got.append(time.monotonic()), QoSProfile(depth=10))
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    start = time.monotonic()
+    process = subprocess.Popen([str(STAGEROS), str(REPO / "worlds" / "rooms.world")], env=env,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        while not got and time.monotonic() - start < timeout:
+            executor.spin_once(timeout_sec=0.01)
+    finally:
+        process.terminate()
+        process.wait(timeout=20)
+        node.destroy_node()
+        rclpy.shutdown()
+    if not got:
+        raise SystemExit(f"no /base_scan within {timeout} s")
+    return got[0] - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=3, help="warm-cache runs (the cold run is one)")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache, STAGE_SIM_KERNELS="numba")
+        cases = [("cold cache", env)] + [("warm cache", env)] * args.runs
+        cases += [("numpy kernels", dict(os.environ, STAGE_SIM_KERNELS="numpy"))] * args.runs
+        for run, (case, case_env) in enumerate(cases):
+            print(json.dumps({"case": case, "run": run, "first_scan_s": round(first_scan(case_env), 2)}), flush=True)
+
+
+if __name__ == "__main__":
+    main()
