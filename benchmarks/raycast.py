@@ -1,7 +1,11 @@
-"""Benchmark of :mod:`stage_sim.sensing.raycast` against a per-ray Amanatides–Woo traversal in numba.
+"""Benchmark of the ray casters (numpy reference and numba kernel) against a plain per-ray numba traversal.
 
-Run with the project's venv python: ``PYTHONPATH=. .venv/bin/python benchmarks/raycast.py``.
-Prints one JSON object per line. numba is used here only, as the reference.
+Run with the project's venv python: ``.venv/bin/python benchmarks/raycast.py``. Prints one JSON object per
+line, pinned to one core: ``rays_per_s`` (numpy caster), ``numba_rays_per_s`` (the simulator's compiled
+kernel, :mod:`stage_sim.sensing.traversal`), ``reference_rays_per_s`` (the plain Amanatides–Woo walk
+below) and their ratios; ``agree``: share of rays whose hit cell equals the reference's (its accumulated
+crossing times round differently from the casters' exact ones on a few rays); ``numba_identical``: whether
+the numba kernel's answers equal the numpy caster's bit for bit.
 """
 
 from __future__ import annotations
@@ -20,8 +24,7 @@ import numba
 import numpy as np
 
 from stage_sim.maps.polygon_raster import outline_points, point_cells
-from stage_sim.sensing.raycast import GridRayCaster
-from stage_sim.sensing.robot_layer import RobotLayer
+from stage_sim.sensing.kernels import make_caster
 
 RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
 MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/
@@ -151,7 +154,8 @@ def main() -> None:
     no_robot = None
     for name in ("rooms", "office_1200x1100"):
         occ, label = load_map(name)
-        caster = GridRayCaster(occ, RESOLUTION, (0.0, 0.0))
+        caster = make_caster(occ, RESOLUTION, (0.0, 0.0), "numpy")
+        fast = make_caster(occ, RESOLUTION, (0.0, 0.0), "numba")
         no_robot = np.full(occ.shape, -1, dtype=np.int32)
         for beams, fov, rmax in CASES:
             xy, angles = scan_batch(occ, POSES, beams, fov, rng)
@@ -162,6 +166,9 @@ def main() -> None:
             result = caster.cast(xy, angles, rmax)
             t_ours = best_of(lambda c=caster, xy=xy, a=angles, r=rmax: c.cast(xy, a, r))
             single = best_of(lambda c=caster, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r), 50)
+            fast_result = fast.cast(xy, angles, rmax)
+            t_fast = best_of(lambda c=fast, xy=xy, a=angles, r=rmax: c.cast(xy, a, r))
+            fast_single = best_of(lambda c=fast, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r), 50)
             emit(
                 case=f"{name}_{beams}",
                 map=label,
@@ -175,11 +182,21 @@ def main() -> None:
                 agree=float(np.mean(result.hit_cell == ref_cell)),
                 max_abs_range_diff_m=float(np.max(np.abs(result.ranges - ref_range))),
                 single_scan_ms=single * 1e3,
+                numba_rays_per_s=len(angles) / t_fast,
+                numba_ratio_to_reference=t_ref / t_fast,
+                numba_identical=identical(fast_result, result),
+                numba_single_scan_ms=fast_single * 1e3,
             )
-    robots_case(occ, label, caster, rng)
+    robots_case(occ, label, caster, fast, rng)
 
 
-def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, fov: float = 240.0, rmax: float = 5.6):
+def identical(a, b) -> bool:
+    """Same hit cells, robots and ranges, bit for bit."""
+    return bool(np.array_equal(a.hit_cell, b.hit_cell) and np.array_equal(a.hit_robot, b.hit_robot)
+                and a.ranges.tobytes() == b.ranges.tobytes())
+
+
+def robots_case(occ, label, caster, fast, rng, robots=1000, beams=240, fov=240.0, rmax=5.6):
     """The simulator's big step: every robot's scan, other robots' footprints in the way."""
     xy, angles = scan_batch(occ, robots, beams, fov, rng)
     centres = xy[::beams]
@@ -192,7 +209,8 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
     points = centres[:, None, :] + np.einsum("rij,pj->rpi", rot, outline)
     point_ids = np.repeat(np.arange(robots), len(outline))
     owners = np.repeat(np.arange(robots), beams)
-    layer = RobotLayer(caster.windows, caster.resolution, caster.origin_xy)
+    layer = caster.robot_layer()
+    fast_layer = fast.robot_layer()
 
     def footprints():
         flat = point_cells(points, RESOLUTION, (0.0, 0.0), occ.shape).ravel()
@@ -210,6 +228,10 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
     t_update = best_of(lambda: layer.update(rows, cols, ids), 3)
     t_cast = best_of(lambda: caster.cast(xy, angles, rmax, owners=owners, robots=layer), 3)
     t_static = best_of(lambda: caster.cast(xy, angles, rmax), 3)
+    fast_layer.update(rows, cols, ids)
+    fast_result = fast.cast(xy, angles, rmax, owners=owners, robots=fast_layer)
+    t_fast = best_of(lambda: fast.cast(xy, angles, rmax, owners=owners, robots=fast_layer), 3)
+    t_fast_update = best_of(lambda: fast_layer.update(rows, cols, ids), 3)
     grid = np.full(occ.shape, -1, dtype=np.int32)
     grid[rows, cols] = ids
     shared = grid[rows, cols] != ids  # cells of two or more robots block every ray
@@ -234,6 +256,11 @@ def robots_case(occ, label, caster, rng, robots: int = 1000, beams: int = 240, f
         layer_update_ms=t_update * 1e3,
         cast_ms=t_cast * 1e3,
         cast_without_robots_ms=t_static * 1e3,
+        numba_rays_per_s=len(angles) / t_fast,
+        numba_ratio_to_reference=t_ref / t_fast,
+        numba_identical=identical(fast_result, result),
+        numba_layer_update_ms=t_fast_update * 1e3,
+        numba_cast_ms=t_fast * 1e3,
     )
 
 
