@@ -49,9 +49,17 @@ run: setup
 test: setup
 	$(PY) -m pytest $(PYTEST_ARGS)
 
+# Both laser cases for 1-1000 robots: numba on one core, numba on 2 threads, numpy on one core (1 and 100
+# robots, for the ratio). One configuration per process, so that each peak_rss_mb is its own.
+SHORT_LASER := --beams 240 --fov 240 --range 5.6
+LONG_LASER := --beams 1081 --fov 270 --range 30
 bench: setup
 	$(PY) benchmarks/raycast.py
-	$(PY) benchmarks/simulate.py
+	for laser in "$(SHORT_LASER)" "$(LONG_LASER)"; do \
+	  $(PY) benchmarks/simulate.py $$laser --kernels numba --threads 1 --robots 1 10 100 1000 && \
+	  $(PY) benchmarks/simulate.py $$laser --kernels numba --threads 2 --robots 1 10 100 1000 && \
+	  $(PY) benchmarks/simulate.py $$laser --kernels numpy --threads 1 --robots 1 100 || exit 1; \
+	done
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts
