@@ -93,3 +93,12 @@ def test_world_without_robots_runs_under_both_kernels():
 def test_every_bundled_world_is_identical_under_both_kernels(name):
     world = load_world(data_root() / "worlds" / name)
     assert run(world, "numba", 1, 5, 3) == run(world, "numpy", 1, 5, 3)
+
+
+def test_a_thousand_robot_crowd_is_identical_under_both_kernels():
+    rows = [f"bot( pose [{0.3 + (i % 40) * 0.19:.2f} {0.3 + (i // 40) * 0.23:.2f} 0 {(i * 37) % 360 - 180}] )"
+            for i in range(1000)]
+    # Packed closer than their size: a jammed crowd of overlapping, stalled robots.
+    world = load_world_text(WORLD.replace("samples 271", "samples 9") + "\n".join(rows) + "\n", "thousand.world")
+    numba_run = run(world, "numba", 2, 2, 9)
+    assert numba_run == run(world, "numpy", 1, 2, 9)
