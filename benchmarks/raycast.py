@@ -24,7 +24,7 @@ import numba
 import numpy as np
 
 from stage_sim.maps.polygon_raster import outline_points, point_cells
-from stage_sim.sensing.kernels import make_caster
+from stage_sim.sensing.casters import make_caster
 
 RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
 MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/

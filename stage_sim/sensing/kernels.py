@@ -25,13 +25,6 @@ import sys
 import warnings
 from functools import cache
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    import numpy as np
-
-    from stage_sim.sensing.fast_caster import NumbaRayCaster
-    from stage_sim.sensing.raycast import GridRayCaster
 
 KERNELS = ("numba", "numpy")
 KERNELS_ENV = "STAGE_SIM_KERNELS"
@@ -82,20 +75,6 @@ def add_kernel_arguments(parser: argparse.ArgumentParser, threads_default: str =
     parser.add_argument("--threads", type=int, default=None,
                         help=f"kernel threads, 0 = all cores, identical results (default: ${THREADS_ENV} or "
                              f"{threads_default})")
-
-
-def make_caster(
-    occupied: np.ndarray, resolution: float, origin_xy: tuple[float, float], kernels: str | None = None,
-    threads: int = 1,
-) -> GridRayCaster | NumbaRayCaster:
-    """A ray caster for one static layer, of the implementation :func:`resolve_kernels` picks."""
-    if resolve_kernels(kernels) == "numba":
-        from stage_sim.sensing.fast_caster import NumbaRayCaster
-
-        return NumbaRayCaster(occupied, resolution, origin_xy, threads)
-    from stage_sim.sensing.raycast import GridRayCaster
-
-    return GridRayCaster(occupied, resolution, origin_xy)
 
 
 def set_threads(threads: int) -> None:

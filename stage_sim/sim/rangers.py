@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
-from stage_sim.sensing.kernels import make_caster
+from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
 from stage_sim.sim.collision import Bodies, GridFrame, place

@@ -6,7 +6,8 @@ from functools import partial
 
 import pytest
 
-from stage_sim.sensing.kernels import KERNELS, make_caster
+from stage_sim.sensing.casters import make_caster
+from stage_sim.sensing.kernels import KERNELS
 
 
 @pytest.fixture(params=KERNELS)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from stage_sim.sensing.kernels import make_caster
+from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
 
 RES = 0.02
