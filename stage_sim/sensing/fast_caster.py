@@ -11,7 +11,7 @@ Memory per layer of H × W cells (rooms.world at 0.02 m: 1082 × 1352 = 1.46 M c
   (1/64 and 1/4096 of that).
 
 The numpy reference instead keeps, per layer, 4 uint8 square fields, 4 uint16 run-length fields and a
-padded int32 robot grid (16 B/cell), and builds them with int64 temporaries.
+padded int32 robot grid (17 B/cell with the padded occupancy copy), and builds them with int64 temporaries.
 """
 
 from __future__ import annotations
