@@ -36,7 +36,8 @@ class RobotCells:
         self.grid = np.full(shape, -1, dtype=np.int32)
         size = 1 << traversal.BLOCK
         self.blocks = np.full((-(-shape[0] // size), -(-shape[1] // size)), -1, dtype=np.int32)
-        self.block_squares = traversal.square_fields(self.blocks != -1)
+        self._blocks_in_use = self.blocks != -1
+        self.block_squares = traversal.square_fields(self._blocks_in_use)
         self._written = np.empty(0, dtype=np.int64)
         self.active = False
 
@@ -51,7 +52,10 @@ class RobotCells:
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         flat = rows * self.shape[1] + cols
         traversal.write_robot_cells(self.grid, self.blocks, self._written, flat, ids.astype(np.int32), SEVERAL_ROBOTS)
-        self.block_squares = traversal.square_fields(self.blocks != -1)
+        in_use = self.blocks != -1
+        if not np.array_equal(in_use, self._blocks_in_use):  # standing or jammed robots keep their blocks
+            self._blocks_in_use = in_use
+            self.block_squares = traversal.square_fields(in_use)
         self._written = flat
         self.active = flat.size > 0
 
