@@ -59,17 +59,18 @@ class RangerSensing:
         self._bodies = bodies
         self._grid = grid
         self._rangers = [(robot.index, ranger) for robot in robots for ranger in robot.rangers]
-        owners, offsets, angles, ranges, heights, ranger_of_ray = [], [], [], [], [], []
+        owners, angles, ranges, heights, ranger_of_ray = [], [], [], [], []
         for k, (robot_index, ranger) in enumerate(self._rangers):
             beams = ranger.beam_angles
             owners.append(np.full(len(beams), robot_index))
-            offsets.append(np.tile(ranger.ray_offset, (len(beams), 1)))
             angles.append(ranger.ray_yaw + beams)
             ranges.append(np.full(len(beams), ranger.sensor.range_max))
             heights.append(np.full(len(beams), ranger.ray_height))
             ranger_of_ray.append(np.full(len(beams), k))
         self._owner = np.concatenate(owners).astype(np.int64) if owners else np.zeros(0, np.int64)
-        self._offset = np.concatenate(offsets) if offsets else np.zeros((0, 2))
+        # Every beam of a ranger starts at the same point: placed once per ranger, not once per beam.
+        self._ranger_offset = np.array([r.ray_offset for _, r in self._rangers], dtype=np.float64).reshape(-1, 2)
+        self._ranger_owner = np.array([i for i, _ in self._rangers], dtype=np.int64)
         self._angle = np.concatenate(angles) if angles else np.zeros(0)
         self._max_range = np.concatenate(ranges) if ranges else np.zeros(0)
         self._ranger_of_ray = np.concatenate(ranger_of_ray).astype(np.int64) if ranger_of_ray else np.zeros(0, int)
@@ -126,7 +127,7 @@ class RangerSensing:
     ) -> None:
         owner = self._owner[rays]
         pose = poses[owner]
-        origins = place(self._offset[rays], pose)
+        origins = place(self._ranger_offset, poses[self._ranger_owner])[self._ranger_of_ray[rays]]
         angles = pose[:, 2] + self._angle[rays] + jitter[rays]
         layer = None
         if robot_cells is not None:
