@@ -134,11 +134,13 @@ def build_static_raster(
     for _, members in groupby(zip(shapes, outlines, strict=True), key=lambda item: (id(item[0].model), item[0].group)):
         parts = list(members)
         shape_of, cells = parts[0][0], np.concatenate([cells for _, cells in parts]) - low
-        outline = np.unique(cells[:, 1] * shape[1] + cells[:, 0])
-        filled = fill_cells([part.points for part, _ in parts], resolution, origin, shape)
+        marked = np.zeros(shape[0] * shape[1], dtype=bool)
+        marked[cells[:, 1] * shape[1] + cells[:, 0]] = True
+        outline = np.flatnonzero(marked)
+        marked[fill_cells([part.points for part, _ in parts], resolution, origin, shape)] = True
         model = shape_of.model
         bodies.append(StaticBody(
-            model.name, np.union1d(filled, outline), outline, shape_of.z, model.ranger_return, model.obstacle_return))
+            model.name, np.flatnonzero(marked), outline, shape_of.z, model.ranger_return, model.obstacle_return))
     return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
 
 
