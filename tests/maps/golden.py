@@ -29,8 +29,18 @@ from stage_sim.worldfile.loader import load_world_text
 from tests.maps.stage_raytrace import stage_ray_ranges
 
 REPO = Path(__file__).resolve().parents[2]
-#: The recordings: ``../shared/fidelity`` beside the repository (as CI clones it), or $STAGE_SIM_FIDELITY.
-FIDELITY = Path(os.environ.get("STAGE_SIM_FIDELITY", REPO.parent / "shared" / "fidelity"))
+
+
+def _recordings() -> Path:
+    """$STAGE_SIM_FIDELITY, else ``shared/fidelity`` beside the repository (as CI clones it) or beside one of
+    its parent directories (a working clone kept in a subdirectory of the project)."""
+    if "STAGE_SIM_FIDELITY" in os.environ:
+        return Path(os.environ["STAGE_SIM_FIDELITY"])
+    beside = [parent / "shared" / "fidelity" for parent in REPO.parents]
+    return next((path for path in beside if path.is_dir()), beside[0])
+
+
+FIDELITY = _recordings()
 WORLD = REPO / "worlds" / "rooms.world"
 VARIANTS = ("A", "B", "C")
 #: How each variant changes rooms.world (the fidelity README's table).
