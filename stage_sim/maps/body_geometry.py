@@ -1,9 +1,15 @@
 """Where model bodies are: Stage's block scaling and the global poses of the model tree.
 
-All blocks of a model are scaled jointly so that the bounding box of their points becomes the model's
-``size`` (x, y) and is centred on the model origin; z values are scaled by size.z / (zmax − zmin) of all
-blocks. A body point q then sits at ``pose ⊕ origin ⊕ q``. Children are posed in their parent's frame and,
-when the parent stacks children (Stage's default), start on top of the parent (parent size.z added to z).
+A body is the model's ``block`` polygons, or the polygons Stage traces from its ``bitmap``
+(:func:`~stage_sim.worldfile.bitmap.trace_outlines`), plus four thin walls when ``boundary 1``. All of them
+are scaled jointly the way Stage's ``BlockGroup::CalcSize`` does it: the bounding box of their points
+becomes the model's ``size`` (x, y) and is centred on the model origin, z values are multiplied by
+size.z / (zmax − zmin) of all blocks. A body point q then sits at ``pose ⊕ origin ⊕ q``. Children are
+posed in their parent's frame and, when the parent stacks children (Stage's default), start on top of
+the parent (parent size.z added to z).
+
+The arithmetic follows Stage's operation by operation (the same sums in the same order), because the
+raster floors these coordinates to cells and a last-bit difference can move a wall by a cell.
 """
 
 from __future__ import annotations
@@ -12,39 +18,59 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stage_sim.worldfile.bitmap import trace_outlines
 from stage_sim.worldfile.description import Model, Pose, WorldDescription
+
+#: Thickness of the walls ``boundary 1`` adds along the edges of the model's size box (Stage's epsilon).
+BOUNDARY_THICKNESS = 0.01
+#: Stage's stand-in for a zero extent, so that a flat body does not divide by zero.
+_TINY = float(np.finfo(np.float64).eps)
 
 
 @dataclass(frozen=True)
 class BodyPolygon:
-    """One scaled block: vertices (M, 2) in the model's pose frame (origin applied) and its z band."""
+    """One scaled block: vertices (M, 2) and its z band (model frame, without the model's z).
+
+    ``group`` says which polygons make one shape together: the outlines traced from one image share a
+    group (an enclosed outline is a hole in the one around it), every block and boundary wall is its own.
+    """
 
     points: np.ndarray
     z: tuple[float, float]
+    group: int = 0
+
+
+def body_shape(model: Model) -> list[BodyPolygon]:
+    """The model's body in its body frame (``origin`` not applied), scaled to its size like Stage."""
+    bitmap = model.bitmap
+    if bitmap is not None and bitmap.grid is not None:
+        polygons = _map_polygons(model)
+    elif bitmap is not None:
+        traced = trace_outlines(bitmap.occupied)
+        polygons = _calc_size([BodyPolygon(p, (0.0, 1.0)) for p in traced], model.size)
+    else:
+        blocks = [BodyPolygon(b.points, b.z, group) for group, b in enumerate(model.blocks)]
+        polygons = _calc_size(blocks, model.size)
+    if model.boundary:
+        polygons = _calc_size(polygons, model.size) + _boundary_walls(polygons, model.size)
+    # Stage sizes the body once more at the end of loading the model.
+    return _calc_size(polygons, model.size) if bitmap is None or bitmap.grid is None else polygons
 
 
 def body_polygons(model: Model) -> list[BodyPolygon]:
-    """The model's blocks scaled to its size and shifted by its origin (Stage §8.6)."""
-    if not model.blocks:
-        return []
-    all_points = np.concatenate([b.points for b in model.blocks])
-    low, high = all_points.min(axis=0), all_points.max(axis=0)
-    extent = np.where(high - low > 0, high - low, 1.0)
-    scale = np.array(model.size[:2]) / extent
-    centre = (low + high) / 2.0
-    z_low = min(b.z[0] for b in model.blocks)
-    z_high = max(b.z[1] for b in model.blocks)
-    z_scale = model.size[2] / (z_high - z_low) if z_high > z_low else 1.0
-    c, s = np.cos(model.origin.yaw), np.sin(model.origin.yaw)
-    rotation = np.array([[c, -s], [s, c]])
-    offset = np.array([model.origin.x, model.origin.y])
-    polygons = []
-    for block in model.blocks:
-        local = (block.points - centre) * scale
-        placed = local @ rotation.T + offset
-        z = (block.z[0] * z_scale + model.origin.z, block.z[1] * z_scale + model.origin.z)
-        polygons.append(BodyPolygon(points=placed, z=z))
-    return polygons
+    """The model's body in its pose frame: :func:`body_shape` with the model's ``origin`` applied."""
+    origin = model.origin
+    frame = Pose(origin.x, origin.y, 0.0, origin.yaw)
+    return [
+        BodyPolygon(transform_points(p.points, frame), (p.z[0] + origin.z, p.z[1] + origin.z), p.group)
+        for p in body_shape(model)
+    ]
+
+
+def body_frame(model: Model, pose: Pose) -> Pose:
+    """Global frame of the body's points for a model at global ``pose``: ``pose ⊕ origin`` (z not included)."""
+    origin = model.origin
+    return pose.compose(Pose(origin.x, origin.y, 0.0, origin.yaw))
 
 
 def global_poses(description: WorldDescription) -> dict[int, Pose]:
@@ -67,6 +93,54 @@ def global_poses(description: WorldDescription) -> dict[int, Pose]:
 
 
 def transform_points(points: np.ndarray, pose: Pose) -> np.ndarray:
-    """Points (M, 2) given in a frame at ``pose`` → world coordinates."""
+    """Points (M, 2) given in a frame at ``pose`` → world coordinates, summed in Stage's order."""
     c, s = np.cos(pose.yaw), np.sin(pose.yaw)
-    return points @ np.array([[c, s], [-s, c]]) + np.array([pose.x, pose.y])
+    x, y = points[:, 0], points[:, 1]
+    return np.stack([pose.x + x * c - y * s, pose.y + x * s + y * c], axis=1)
+
+
+def _calc_size(polygons: list[BodyPolygon], size: tuple[float, float, float]) -> list[BodyPolygon]:
+    """Stage's ``CalcSize``: stretch the joint bounding box to ``size`` and centre it (z: scale only)."""
+    if not polygons:
+        return []
+    points = np.concatenate([p.points for p in polygons])
+    low, high = points.min(axis=0), points.max(axis=0)
+    z_low, z_high = min(p.z[0] for p in polygons), max(p.z[1] for p in polygons)
+    extent = np.array([high[0] - low[0], high[1] - low[1], z_high - z_low])
+    extent = np.where(np.abs(extent) >= _TINY, extent, _TINY)
+    offset = low + extent[:2] / 2.0
+    scale = np.asarray(size, dtype=np.float64) / extent
+    return [
+        BodyPolygon((p.points - offset) * scale[:2], (p.z[0] * scale[2], p.z[1] * scale[2]), p.group)
+        for p in polygons
+    ]
+
+
+def _boundary_walls(polygons: list[BodyPolygon], size: tuple[float, float, float]) -> list[BodyPolygon]:
+    """The four thin rectangles ``boundary 1`` adds inside the body's bounding box (Stage's order)."""
+    if polygons:
+        points = np.concatenate([p.points for p in polygons])
+        (x0, y0), (x1, y1) = points.min(axis=0), points.max(axis=0)
+        z0, z1 = min(p.z[0] for p in polygons), max(p.z[1] for p in polygons)
+    else:
+        (x0, y0), (x1, y1), (z0, z1) = (-size[0] / 2, -size[1] / 2), (size[0] / 2, size[1] / 2), (0.0, size[2])
+    w, h, t = x1 - x0, y1 - y0, BOUNDARY_THICKNESS
+    rects = ((x0, y0, t, h), (x0, y0, w, t), (x0, y1 - t, w, t), (x1 - t, y0, t, h))
+    first = max((p.group for p in polygons), default=-1) + 1
+    return [
+        BodyPolygon(np.array([[x, y], [x + dx, y], [x + dx, y + dy], [x, y + dy]]), (0.0, z1 - z0), first + k)
+        for k, (x, y, dx, dy) in enumerate(rects)
+    ]
+
+
+def _map_polygons(model: Model) -> list[BodyPolygon]:
+    """A map_server map's outlines at its own resolution and origin: no trimming, no stretching (§9.2)."""
+    grid = model.bitmap.grid
+    rows = model.bitmap.occupied.shape[0]
+    ox, oy, oyaw = grid.origin
+    corner = Pose(ox, oy, 0.0, oyaw)
+    return [
+        BodyPolygon(transform_points(np.stack([p[:, 0], p[:, 1] + rows], axis=1) * grid.resolution, corner),
+                    (0.0, model.size[2]))
+        for p in trace_outlines(model.bitmap.occupied)
+    ]

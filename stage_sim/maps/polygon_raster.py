@@ -1,13 +1,17 @@
-"""Turning polygons into grid cells: filled static bodies and sampled outlines of moving bodies.
+"""Turning polygons into grid cells: Stage's edge raster, filled footprints and sampled outlines.
 
 Cell (row r, col c) covers x ∈ [x0 + c·res, x0 + (c+1)·res), y ∈ [y0 + r·res, y0 + (r+1)·res), with
 (x0, y0) the grid origin (lower-left corner of cell (0, 0)); flat index = r·width + c.
 
-Static bodies are *filled*: a cell belongs to a polygon when its centre is inside (even-odd rule) or when
-an edge of the polygon passes through it, so walls thinner than a cell are never lost. Robots are
-represented by points sampled densely along their outlines (at most half a cell apart), which is what
-Stage rasterises too: a ray or another body cannot reach the inside without crossing the outline, and the
-outline is cheap to move every step for thousands of robots.
+* **Stage's raster** (:func:`vertex_cells`, :func:`edge_cells`): what rays and collisions see. Stage floors
+  each polygon vertex to its cell (``floor(x · ppm)``, ppm = 1 / resolution, cells anchored at the world
+  origin) and walks each edge from its start cell to its end cell in 4-connected steps (``World::MapPoly``,
+  Cohen's integer line), marking every cell but the end one (the next edge starts there). Only edges
+  exist: the inside of a polygon is empty unless an edge runs through it.
+* **Filled footprints** (:func:`fill_cells`, :func:`fill_polygon`): cells whose centre is inside (even-odd
+  rule) or that an edge passes through; what a map of the world shows, never what a ray sees.
+* **Sampled outlines** (:func:`outline_points`): points at most ``spacing`` apart along a moving body's
+  outline, cheap to move every step for thousands of robots.
 """
 
 from __future__ import annotations
@@ -17,6 +21,71 @@ import numpy as np
 # Edge sampling step as a fraction of the cell size: a quarter cell keeps every cell an edge crosses by
 # more than a sliver, at a cost that only matters once, when the static world is built.
 EDGE_SAMPLES_PER_CELL = 4
+
+
+def vertex_cells(points: np.ndarray, resolution: float) -> np.ndarray:
+    """Stage's integer cell (col, row) of each world point (M, 2), counted from the world origin."""
+    ppm = 1.0 / resolution
+    return np.floor(points * ppm).astype(np.int64)
+
+
+def edge_cells(polygons: list[np.ndarray]) -> np.ndarray:
+    """Cells (K, 2) as (col, row) that Stage marks for closed polygons given by vertex cells (M, 2) each.
+
+    Edge a → b with ax = |bx − ax|, ay = |by − ay| takes ax + ay unit steps from a; at each step the error
+    term (2i+1)·ay − (2j+1)·ax (after i x-steps and j y-steps) picks x when negative, else y: the cells a
+    line from the centre of a's cell to the centre of b's cell passes through, a y-step first on a tie.
+    An edge within one cell marks nothing. Cells may repeat.
+    """
+    if not polygons:
+        return np.zeros((0, 2), dtype=np.int64)
+    start = np.concatenate(polygons).astype(np.int64)
+    end = np.concatenate([np.roll(p, -1, axis=0) for p in polygons]).astype(np.int64)
+    delta = end - start
+    ax, ay = np.abs(delta[:, 0]), np.abs(delta[:, 1])
+    steps = ax + ay
+    if steps.sum() == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    edge = np.repeat(np.arange(len(steps)), steps)
+    first = np.cumsum(steps) - steps
+    k = np.arange(edge.size) - first[edge]
+    is_x = k < ax[edge]
+    # Step k of an edge is its i-th x-step or j-th y-step; sort each edge's steps by when the centre line
+    # crosses the grid line: x-step i at (2i+1)/(2ax), y-step j at (2j+1)/(2ay), y first on a tie.
+    nth = np.where(is_x, k, k - ax[edge])
+    when = np.where(is_x, 2 * (2 * nth + 1) * ay[edge] + 1, 2 * (2 * nth + 1) * ax[edge])
+    is_x = is_x[np.lexsort((when, edge))]
+    # Cells are marked before each step: count the x- and y-steps taken earlier on the same edge.
+    x_before = np.cumsum(is_x) - is_x
+    y_before = np.cumsum(~is_x) - ~is_x
+    x_before -= x_before[first[edge]]
+    y_before -= y_before[first[edge]]
+    direction = np.sign(delta)[edge]
+    return start[edge] + direction * np.stack([x_before, y_before], axis=1)
+
+
+def fill_cells(
+    polygons: list[np.ndarray], resolution: float, origin_xy: tuple[float, float], shape: tuple[int, int]
+) -> np.ndarray:
+    """Sorted unique flat indices of the cells whose centre is inside the polygons (even-odd over all)."""
+    if not polygons:
+        return np.zeros(0, dtype=np.int64)
+    points = np.concatenate(polygons)
+    low = np.floor((points.min(axis=0) - origin_xy) / resolution).astype(int)
+    high = np.ceil((points.max(axis=0) - origin_xy) / resolution).astype(int)
+    col0, row0 = np.maximum(low, 0)
+    col1, row1 = np.minimum(high, (shape[1], shape[0]))
+    if col1 <= col0 or row1 <= row0:
+        return np.zeros(0, dtype=np.int64)
+    cols = np.arange(col0, col1)
+    rows = np.arange(row0, row1)
+    cx = origin_xy[0] + (cols + 0.5) * resolution
+    cy = origin_xy[1] + (rows + 0.5) * resolution
+    inside = np.zeros((len(cy), len(cx)), dtype=bool)
+    for polygon in polygons:
+        _toggle_inside(inside, polygon, cx, cy)
+    r, c = np.nonzero(inside)
+    return (rows[r] * shape[1] + cols[c]).astype(np.int64)
 
 
 def outline_points(polygon: np.ndarray, spacing: float) -> np.ndarray:
@@ -43,28 +112,14 @@ def point_cells(
 def fill_polygon(
     polygon: np.ndarray, resolution: float, origin_xy: tuple[float, float], shape: tuple[int, int]
 ) -> np.ndarray:
-    """Sorted unique flat indices of the cells a filled polygon (M, 2) in world coordinates covers."""
-    edge_cells = point_cells(outline_points(polygon, resolution / EDGE_SAMPLES_PER_CELL), resolution, origin_xy, shape)
-    low = np.floor((polygon.min(axis=0) - origin_xy) / resolution).astype(int)
-    high = np.ceil((polygon.max(axis=0) - origin_xy) / resolution).astype(int)
-    col0, row0 = np.maximum(low, 0)
-    col1, row1 = np.minimum(high, (shape[1], shape[0]))
-    inner = np.empty(0, dtype=np.int64)
-    if col1 > col0 and row1 > row0:
-        cols = np.arange(col0, col1)
-        rows = np.arange(row0, row1)
-        cx = origin_xy[0] + (cols + 0.5) * resolution
-        cy = origin_xy[1] + (rows + 0.5) * resolution
-        inside = _centres_inside(polygon, cx, cy)
-        r, c = np.nonzero(inside)
-        inner = (rows[r] * shape[1] + cols[c]).astype(np.int64)
-    cells = np.concatenate([inner, edge_cells[edge_cells >= 0]])
-    return np.unique(cells)
+    """Sorted unique flat indices of the cells a filled polygon (M, 2) in world coordinates covers:
+    centres inside, plus every cell an edge passes through (sampled), so no thin wall is lost."""
+    edge = point_cells(outline_points(polygon, resolution / EDGE_SAMPLES_PER_CELL), resolution, origin_xy, shape)
+    return np.unique(np.concatenate([fill_cells([polygon], resolution, origin_xy, shape), edge[edge >= 0]]))
 
 
-def _centres_inside(polygon: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.ndarray:
-    """Even-odd test of the grid of centres (len(cy), len(cx)) against the polygon, one edge at a time."""
-    inside = np.zeros((len(cy), len(cx)), dtype=bool)
+def _toggle_inside(inside: np.ndarray, polygon: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> None:
+    """Flip ``inside`` (len(cy), len(cx)) for the centres left of each edge of ``polygon`` (even-odd)."""
     x1s, y1s = polygon[:, 0], polygon[:, 1]
     x2s, y2s = np.roll(x1s, -1), np.roll(y1s, -1)
     for x1, y1, x2, y2 in zip(x1s, y1s, x2s, y2s, strict=True):
@@ -75,4 +130,3 @@ def _centres_inside(polygon: np.ndarray, cx: np.ndarray, cy: np.ndarray) -> np.n
             continue
         x_cross = x1 + (cy[spans] - y1) * (x2 - x1) / (y2 - y1)
         inside[spans] ^= cx[None, :] < x_cross[:, None]
-    return inside

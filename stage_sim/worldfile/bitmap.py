@@ -3,18 +3,25 @@
 Stage (FLTK) tests only the first byte of each pixel: grey, or red for colour images. A pixel is
 occupied iff that byte is <= 127. Alpha is ignored. The occupied pixels' bounding box is later stretched
 to the model ``size`` (spec §9.1), hence :func:`occupied_bounding_box`.
+
+Stage does not keep the pixels: it traces the borders of the occupied regions into closed polygons
+(:func:`trace_outlines`, Stage's ``polys_from_image_file``) and only those polygons' edges ever reach the
+world raster, so the exact vertices Stage makes (where it merges straight runs, where it does not) decide
+which cells a rotated or scaled bitmap occupies.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from PIL import Image, UnidentifiedImageError
 
 from stage_sim.worldfile.errors import SourceLocation, WorldError
+
+if TYPE_CHECKING:
+    from PIL import Image
 
 #: Largest first-channel value that Stage still counts as occupied.
 STAGE_OCCUPIED_MAX = 127
@@ -71,6 +78,8 @@ def read_image(
     ``kind`` names the file in messages ("bitmap", "map image"); ``requested_at`` is where the world or
     YAML file asked for it.
     """
+    from PIL import Image, UnidentifiedImageError  # only reading images needs Pillow, tracing does not
+
     path = Path(path)
     if not path.is_file():
         what = f"{kind} not found: {path}" if not path.exists() else f"{kind} is not a file: {path}"
@@ -85,6 +94,8 @@ def read_image(
 
 def _to_channels(image: Image.Image) -> np.ndarray:
     """Convert any Pillow mode to (H, W, C) uint8 as described on :class:`ImagePixels`."""
+    from PIL import Image
+
     mode = image.mode
     if mode in _SIXTEEN_BIT_MODES:
         wide = np.asarray(image, dtype=np.int64)
@@ -129,3 +140,86 @@ def occupied_bounding_box(mask: np.ndarray) -> PixelBox | None:
         return None
     cols = np.flatnonzero(mask.any(axis=0))
     return PixelBox(int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1)
+
+
+def trace_outlines(mask: np.ndarray) -> list[np.ndarray]:
+    """Stage's polygons for an occupied mask (row 0 = top): a list of (M, 2) float vertex arrays.
+
+    Vertices are pixel corners with the image y flipped: pixel (col i, row j) spans x in [i, i+1] and
+    y in [-(j+1), -j]. As in Stage, every occupied pixel contributes its four directed border edges,
+    edges shared by two occupied pixels cancel, and the remaining edges are chained starting from the
+    smallest corner (x, then y) still unused; at a corner with two ways on, the smaller end corner is
+    taken. A new vertex replaces the previous one when it continues in the same direction, but only once
+    the polygon has three vertices, so the first corners of a polygon are never merged (Stage's rule).
+    """
+    height = mask.shape[0]
+    starts, ends = _border_edges(np.asarray(mask, dtype=bool))
+    # A corner (x, y) as one integer that sorts like Stage's (x, then y) comparison.
+    stride = height + 1
+    start_key = starts[:, 0] * stride + starts[:, 1]
+    order = np.lexsort((ends[:, 1], ends[:, 0], start_key))
+    start_key, ends = start_key[order].tolist(), (ends[order, 0] * stride + ends[order, 1]).tolist()
+    first_out: dict[int, int] = {}
+    for index in range(len(start_key) - 1, -1, -1):
+        first_out[start_key[index]] = index
+    used = [False] * len(start_key)
+    polygons = []
+    for seed in range(len(start_key)):
+        if used[seed]:
+            continue
+        polygons.append(_chain(seed, start_key, ends, first_out, used, stride))
+    return polygons
+
+
+def _border_edges(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Directed edges (start corners, end corners) between occupied pixels and free ones or the outside."""
+    padded = np.pad(mask, 1)
+    rows, cols = np.nonzero(mask)
+    x, y = cols, rows
+    sides = (  # (free neighbour, start corner, end corner) in Stage's order: top, right, bottom, left
+        (~padded[rows, cols + 1], (x, y), (x + 1, y)),
+        (~padded[rows + 1, cols + 2], (x + 1, y), (x + 1, y + 1)),
+        (~padded[rows + 2, cols + 1], (x + 1, y + 1), (x, y + 1)),
+        (~padded[rows + 1, cols], (x, y + 1), (x, y)),
+    )
+    starts = np.concatenate([np.stack(start, axis=1)[keep] for keep, start, _ in sides])
+    ends = np.concatenate([np.stack(end, axis=1)[keep] for keep, _, end in sides])
+    return starts.astype(np.int64), ends.astype(np.int64)
+
+
+def _chain(
+    seed: int, start_key: list[int], ends: list[int], first_out: dict[int, int], used: list[bool], stride: int
+) -> np.ndarray:
+    """Follow unused edges from edge ``seed`` until none leaves the current corner; merge straight runs."""
+    points: list[tuple[int, int]] = []
+    edge = seed
+    while edge is not None:
+        used[edge] = True
+        x, y = divmod(start_key[edge], stride)
+        point = (x, -y)
+        if len(points) > 2:
+            (x0, y0), (x1, y1) = points[-2], points[-1]
+            straight = _sign(x1 - x0) == _sign(point[0] - x1) and _sign(y1 - y0) == _sign(point[1] - y1)
+            if straight:
+                points[-1] = point
+            else:
+                points.append(point)
+        else:
+            points.append(point)
+        edge = _next_unused(ends[edge], start_key, first_out, used)
+    return np.array(points, dtype=np.float64)
+
+
+def _next_unused(corner: int, start_key: list[int], first_out: dict[int, int], used: list[bool]) -> int | None:
+    """The first unused edge leaving ``corner`` in Stage's order, None when there is none."""
+    index = first_out.get(corner)
+    while index is not None and index < len(start_key) and start_key[index] == corner:
+        if not used[index]:
+            first_out[corner] = index
+            return index
+        index += 1
+    return None
+
+
+def _sign(value: int) -> int:
+    return (value > 0) - (value < 0)
