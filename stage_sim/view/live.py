@@ -90,7 +90,8 @@ class LiveView:
         if isinstance(action, Drive):
             controls.drive(action.robot, action.vx, action.vy, action.va)
         elif isinstance(action, Place):
-            self.sim.set_pose(action.robot, action.x, action.y, action.yaw)
+            yaw = self.sim.true_poses[action.robot][2] if action.yaw is None else action.yaw
+            self.sim.set_pose(action.robot, action.x, action.y, yaw)
         elif isinstance(action, Pause):
             controls.set_paused(action.paused)
         elif isinstance(action, Speed):

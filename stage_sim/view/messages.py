@@ -38,12 +38,12 @@ class Drive:
 
 @dataclass(frozen=True)
 class Place:
-    """A robot dragged (or turned) to a new true pose."""
+    """A robot dragged (or turned) to a new true pose; no ``yaw`` keeps its heading."""
 
     robot: int
     x: float
     y: float
-    yaw: float
+    yaw: float | None
 
 
 @dataclass(frozen=True)
@@ -97,7 +97,7 @@ class MessageReader:
             x, y = _number(data, "x", max(abs(x0), abs(x1))), _number(data, "y", max(abs(y0), abs(y1)))
             if not (x0 <= x <= x1 and y0 <= y <= y1):
                 raise BadMessage(f"pose ({x:g}, {y:g}) is far outside the world")
-            return Place(robot, x, y, _number(data, "yaw", 100.0))
+            return Place(robot, x, y, _number(data, "yaw", 100.0) if "yaw" in data else None)
         if kind == "pause":
             paused = data.get("paused")
             if not isinstance(paused, bool):

@@ -60,8 +60,8 @@ export class Input {
     const start = { px, py, moved: false };
     if (robot >= 0 && !this.state.scene.readonly) {
       const [wx, wy] = this.state.camera.canvasToWorld(px, py);
-      const [x, y, yaw] = this.state.frame.poses[robot];
-      this.drag = { ...start, robot, dx: x - wx, dy: y - wy, yaw };
+      const [x, y] = this.state.frame.poses[robot];
+      this.drag = { ...start, robot, dx: x - wx, dy: y - wy };
     } else {
       this.drag = { ...start, robot };
     }
@@ -82,7 +82,7 @@ export class Input {
       if (e.shiftKey) {
         this.actions.send({ type: "pose", robot: name, x, y, yaw: Math.atan2(wy - y, wx - x) });
       } else {
-        this.actions.send({ type: "pose", robot: name, x: wx + drag.dx, y: wy + drag.dy, yaw: this.state.frame.poses[drag.robot][2] });
+        this.actions.send({ type: "pose", robot: name, x: wx + drag.dx, y: wy + drag.dy });
       }
     } else if (drag.robot < 0) {
       camera.panBy(px - (drag.lastX ?? drag.px), py - (drag.lastY ?? drag.py));
