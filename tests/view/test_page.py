@@ -154,6 +154,17 @@ def test_p_pauses_and_resumes_sim_time(page, served) -> None:
     assert served.sim.sim_time > paused_at + 0.3
 
 
+def test_the_snapshot_button_saves_the_view_as_png(page, served) -> None:
+    with page.expect_download() as download:
+        page.get_by_role("button", name="Snapshot").click()
+    path = download.value.path()
+    image = Image.open(path)
+    assert image.format == "PNG"
+    assert image.size == tuple(page.evaluate("[document.getElementById('world').width, "
+                                             "document.getElementById('world').height]"))
+    assert len(np.unique(np.asarray(image.convert("RGB")).reshape(-1, 3), axis=0)) > 10  # not a blank canvas
+
+
 def test_d_hides_and_shows_the_laser_data(page, served) -> None:
     settle(page, served)
 

@@ -115,6 +115,7 @@ export class Input {
     const key = e.key;
     if (key in MOVES) {
       this.held = key;
+      this.heldCode = e.code;  // the physical key: its key-up may carry another character (Shift released first)
       if (!e.repeat) this.sendHeld();
       e.preventDefault();
       return;
@@ -138,7 +139,7 @@ export class Input {
   }
 
   keyUp(e) {
-    if (this.held !== null && e.key.toLowerCase() === this.held.toLowerCase()) this.release();
+    if (this.held !== null && e.code === this.heldCode) this.release();
   }
 
   release() {
