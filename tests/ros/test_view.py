@@ -102,14 +102,22 @@ def test_no_view_with_g(ros_context) -> None:
 
 @pytest.mark.slow
 def test_the_console_script_prints_the_view_url_once_and_minus_g_none(tmp_path) -> None:
-    def output_of(*args: str) -> str:
+    def output_of(*args: str, until: str) -> list[str]:
+        """stageros' output lines until one holds ``until``, and a second more."""
         process = subprocess.Popen([str(STAGEROS), *args, "rooms.world"], cwd=tmp_path, env=dict(os.environ),
                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        time.sleep(4.0)
-        process.terminate()
-        output, _ = process.communicate(timeout=20)
-        return output
+        lines = []
+        try:
+            for line in process.stdout:
+                lines.append(line.rstrip("\n"))
+                if until in line:
+                    break
+            time.sleep(1.0)
+        finally:
+            process.terminate()
+            lines += process.communicate(timeout=30)[0].splitlines()
+        return lines
 
-    lines = [line for line in output_of("--view-port", "0").splitlines() if line.startswith("view: ")]
-    assert len(lines) == 1 and lines[0].startswith("view: http://127.0.0.1:") and lines[0].endswith("/")
-    assert "view: " not in output_of("-g")
+    views = [line for line in output_of("--view-port", "0", until="view: ") if line.startswith("view: ")]
+    assert len(views) == 1 and views[0].startswith("view: http://127.0.0.1:") and views[0].endswith("/")
+    assert not [line for line in output_of("-g", until="robot(s), interval_sim") if line.startswith("view: ")]
