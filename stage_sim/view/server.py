@@ -175,19 +175,23 @@ class ViewServer:
         socket = web.WebSocketResponse(max_msg_size=MAX_FRAME_BYTES, heartbeat=10.0)
         await socket.prepare(request)
         page = _Page(socket)
-        await socket.send_str(self._scene_text)
-        if self._latest is not None:
-            page.offer(self._latest)
-        self._pages.add(page)
-        sender = asyncio.create_task(self._send(page))
+        sender: asyncio.Task | None = None
         try:
+            await socket.send_str(self._scene_text)  # the scene first, then frames
+            if self._latest is not None:
+                page.offer(self._latest)
+            self._pages.add(page)
+            sender = asyncio.create_task(self._send(page))
             async for message in socket:
                 if message.type in (WSMsgType.TEXT, WSMsgType.BINARY) and not self._receive(page, message.data):
                     await socket.close(code=1008, message=b"too many malformed messages")
                     break
+        except ConnectionError:  # the page went away mid-message: nothing to clean up beyond the finally
+            pass
         finally:
             self._pages.discard(page)
-            sender.cancel()
+            if sender is not None:
+                sender.cancel()
         return socket
 
     async def _send(self, page: _Page) -> None:
