@@ -60,7 +60,7 @@ clean-venv:
 
 # README pictures, one command each: docs/rooms.png (the robot and its laser after a few steps),
 # docs/rooms.gif (a minute of the wanderer, a frame every 0.5 sim seconds, played 5x faster than real time),
-# docs/view.png (the browser view in headless Chromium, after 40 sim seconds of the wanderer).
+# docs/view.png (the browser view in headless Chromium: four wanderers after 20 sim seconds).
 .PHONY: pictures
 pictures: setup
 	@mkdir -p docs

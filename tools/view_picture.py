@@ -1,7 +1,7 @@
 """The README's picture of the browser view: ``python tools/view_picture.py OUT.png`` (``make pictures``).
 
-Runs ``WORLD`` (default rooms.world) with the wanderer for ``--sim-seconds`` as fast as possible, pauses it,
-opens the page in Debian's headless Chromium, selects the first robot and saves a screenshot of the page.
+Runs ``--world`` (default multi_robots.world) with the wanderer for ``--sim-seconds`` at 4x real time, watched
+by a page in Debian's headless Chromium; then pauses it, clicks the first robot and saves a screenshot.
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from tests.view.conftest import CHROMIUM, CHROMIUM_FLAGS  # noqa: E402
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("output", type=Path)
-    parser.add_argument("--world", default=str(REPO / "worlds" / "rooms.world"))
-    parser.add_argument("--sim-seconds", type=float, default=40.0)
+    parser.add_argument("--world", default=str(REPO / "worlds" / "multi_robots.world"))
+    parser.add_argument("--sim-seconds", type=float, default=20.0)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
     if not CHROMIUM.exists():
@@ -50,6 +50,10 @@ def main() -> int:
         final.start()
         page.wait_for_function("t => stageView.state.drawnFrame.paused && stageView.state.drawnFrame.time >= t",
                                arg=sim.sim_time - 1e-6)
+        box = page.locator("#world").bounding_box()
+        x, y = page.evaluate("([x, y]) => stageView.worldToCanvas(x, y)", [float(v) for v in sim.true_poses[0][:2]])
+        page.mouse.click(box["x"] + x, box["y"] + y)  # select the first robot, as a user would
+        page.wait_for_function("stageView.state.selected === 0 && !document.getElementById('selection').hidden")
         page.screenshot(path=str(args.output))
         browser.close()
     stop.set()
