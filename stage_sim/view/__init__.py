@@ -9,7 +9,7 @@ built, so the command-line options cost nothing.
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 _EXPORTS = {
     "Controls": "stage_sim.view.live",
@@ -20,7 +20,14 @@ _EXPORTS = {
     "add_view_arguments": "stage_sim.view.options",
     "view_settings": "stage_sim.view.options",
 }
-__all__ = sorted(_EXPORTS)
+__all__ = [
+    "DEFAULT_PORT", "Controls", "LiveView", "PacedLoop", "ViewSettings", "add_view_arguments", "view_settings",
+]
+
+if TYPE_CHECKING:
+    from stage_sim.view.live import Controls, LiveView
+    from stage_sim.view.loop import PacedLoop
+    from stage_sim.view.options import DEFAULT_PORT, ViewSettings, add_view_arguments, view_settings
 
 
 def __getattr__(name: str) -> Any:

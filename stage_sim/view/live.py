@@ -14,7 +14,7 @@ import time
 from typing import TYPE_CHECKING, Protocol
 
 from stage_sim.view.frames import FrameSampler
-from stage_sim.view.messages import Drive, MessageReader, Pause, Place, Reset, Speed
+from stage_sim.view.messages import Action, Drive, MessageReader, Pause, Place, Speed
 from stage_sim.view.scene import Scene, robot_names
 from stage_sim.view.server import ViewServer, ViewSettings
 
@@ -85,7 +85,7 @@ class LiveView:
             if frame is not None:
                 self.server.publish(frame)
 
-    def _apply(self, action: Drive | Place | Pause | Speed | Reset) -> None:
+    def _apply(self, action: Action) -> None:
         controls = self.controls
         if isinstance(action, Drive):
             controls.drive(action.robot, action.vx, action.vy, action.va)
