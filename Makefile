@@ -68,10 +68,12 @@ lint: setup
 clean-venv:
 	rm -rf $(VENV)
 
-# README pictures, one command each: docs/rooms.png (the robot and its laser after a few steps) and
-# docs/rooms.gif (a minute of the wanderer, a frame every 0.5 sim seconds, played 5x faster than real time).
+# README pictures, one command each: docs/rooms.png (the robot and its laser after a few steps),
+# docs/rooms.gif (a minute of the wanderer, a frame every 0.5 sim seconds, played 5x faster than real time),
+# docs/view.png (the browser view in headless Chromium: four wanderers after 20 sim seconds).
 .PHONY: pictures
 pictures: setup
 	@mkdir -p docs
 	$(VENV)/bin/stage_sim render worlds/rooms.world --steps 10 -o docs/rooms.png
 	$(VENV)/bin/stage_sim render worlds/rooms.world --steps 600 --controller wander --trail 30 --record-fps 10 -o docs/rooms.gif
+	$(PY) tools/view_picture.py docs/view.png

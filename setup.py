@@ -16,14 +16,16 @@ setup(
     license="Apache-2.0",
     python_requires=">=3.10",
     packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*"]),
+    # The browser view's page (HTML, JavaScript modules, CSS), served from the installed package.
+    package_data={f"{PACKAGE}.view": ["page/*.html", "page/*.css", "page/js/*.js"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
-    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow"],
-    extras_require={"test": ["pytest"]},
-    zip_safe=True,
+    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp"],
+    extras_require={"test": ["pytest", "playwright"]},
+    zip_safe=False,
     entry_points={
         "console_scripts": [
             "stage_sim = stage_sim.cli:main",

@@ -35,7 +35,7 @@ def cpu_seconds(pid: int) -> float:
 
 
 def measure(case: str, world: Path, robots: int, speedup: str, wall_s: float) -> dict:
-    process = subprocess.Popen([str(STAGEROS), "--speedup", speedup, str(world)], env=dict(os.environ),
+    process = subprocess.Popen([str(STAGEROS), "-g", "--speedup", speedup, str(world)], env=dict(os.environ),
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     rclpy.init()
     node = rclpy.create_node("stageros_benchmark")

@@ -23,6 +23,7 @@ from stage_sim.ros.recording import recording
 from stage_sim.ros.session import parse_args
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.teleop import KeyReader, TeleopTwistKeyboard
+from stage_sim.ros.view import viewing
 from stage_sim.worldfile.errors import WorldError
 
 
@@ -51,7 +52,7 @@ def main(argv: list[str]) -> int:
             for node in nodes:
                 executor.add_node(node)
             spinner = threading.Thread(target=spin, name="stage-spin", daemon=True)
-            with recording(stage, args, "teleop.py"):
+            with recording(stage, args, "teleop.py"), viewing(stage, args):
                 spinner.start()
                 try:
                     with KeyReader(sys.stdin) as keys:

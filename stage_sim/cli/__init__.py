@@ -1,9 +1,10 @@
 """The ``stage_sim`` console script: ROS-free tools around world files, one module per subcommand.
 
 ``stage_sim inspect WORLD [--json]`` shows what the simulator will make of a world; ``stage_sim render WORLD
--o out.png`` draws it (``-o out.gif`` records a run). Exit status 0 on success, 2 when the world cannot be
-loaded (the message, with file:line:column, goes to stderr). A new subcommand is a module with
-``add_command(subparsers)`` that sets ``run``, listed in :data:`COMMANDS`.
+-o out.png`` draws it (``-o out.gif`` records a run); ``stage_sim view WORLD`` runs it live in the browser.
+Exit status 0 on success, 2 when the world cannot be loaded (the message, with file:line:column, goes to
+stderr). A new subcommand is a module with ``add_command(subparsers)`` that sets ``run``, listed in
+:data:`COMMANDS`.
 """
 
 from __future__ import annotations
@@ -13,10 +14,10 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from stage_sim.cli import inspect, render
+from stage_sim.cli import inspect, render, view
 from stage_sim.worldfile.errors import WorldError
 
-COMMANDS: list[Callable[[Any], None]] = [inspect.add_command, render.add_command]
+COMMANDS: list[Callable[[Any], None]] = [inspect.add_command, render.add_command, view.add_command]
 """Each entry adds one subcommand and sets ``run``."""
 
 

@@ -17,7 +17,6 @@ import threading
 import time
 
 import rclpy
-from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
@@ -26,6 +25,7 @@ from rclpy.signals import SignalHandlerOptions
 from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.stageros import StageRos
+from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.ros.wander import Wander
 from stage_sim.runs.driver import wanderer_seed
 from stage_sim.runs.stats import RunStats
@@ -55,20 +55,22 @@ class WanderSession:
         for node in (self.stage, *self.wanderers):
             self.executor.add_node(node)
         self.stats = RunStats(sim)
+        self.stage.add_step_listener(self.stats.update)
 
     def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
         """Step until ``duration`` sim seconds, the world's quit_time, or ``stop`` is set (Ctrl-C)."""
         stop = stop or threading.Event()
         self._connect()
         stage, sim = self.stage, self.stage.sim
-        if stage.speedup > 0:
-            stage.create_timer(sim.interval / stage.speedup, self._step, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        lockstep = stage.speedup <= 0
+        if not lockstep:
+            stage.start_stepping()
         while not stage.finished and not stop.is_set() and (duration is None or sim.sim_time < duration - 1e-9):
-            if stage.speedup > 0:
-                self.executor.spin_once(timeout_sec=0.1)
-            else:
-                self._step()
+            if lockstep and not stage.paused:
+                stage.step_once()
                 self._await_answers()
+            else:
+                self.executor.spin_once(timeout_sec=0.1)
 
     def summaries(self) -> list[dict]:
         """The per-robot JSON summaries, named after the robots' models."""
@@ -80,10 +82,6 @@ class WanderSession:
             self.executor.remove_node(node)
             node.destroy_node()
         self.executor.shutdown(timeout_sec=1.0)
-
-    def _step(self) -> None:
-        self.stage.step_once()
-        self.stats.update()
 
     def _connect(self) -> None:
         """Spin until every scan, odometry and command topic has matched (discovery, even in-process)."""
@@ -115,6 +113,7 @@ def parse_args(argv: list[str], prog: str, default_world: str, description: str)
     parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")
     parser.add_argument("--seed", type=int, default=None, help="seed of the simulator and the wanderers")
     add_record_arguments(parser)
+    add_view_options(parser)
     return parser.parse_args(argv)
 
 
@@ -126,7 +125,7 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     try:
         with stop_requests() as stop:
             session = WanderSession(args.world, args.speedup, args.seed)
-            with recording(session.stage, args, prog):
+            with recording(session.stage, args, prog), viewing(session.stage, args):
                 session.run(args.duration, stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)

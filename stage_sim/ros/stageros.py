@@ -24,6 +24,7 @@ from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallba
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.timer import Timer
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
@@ -104,9 +105,9 @@ class StageRos(Node):
         self.quit_time = description.settings.quit_time
         self.finished = False
         self._step_listeners: list[Callable[[], None]] = []
-        period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0
-        self._timer = self.create_timer(
-            period, self.step_once, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=autostep)
+        self.paused = False
+        self.autostep = autostep
+        self._timer = self._step_timer(autostep)
         self._publish_static()
         self.get_logger().info(
             f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
@@ -146,6 +147,11 @@ class StageRos(Node):
             for robot, names in zip(self.sim.robots, self.names, strict=True)
         ]
         self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
+
+    def _step_timer(self, start: bool) -> Timer:
+        """The steady wall timer that steps the world every ``interval_sim / speedup`` (0: back to back)."""
+        period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0
+        return self.create_timer(period, self.step_once, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
 
     def _robot_publisher(self, msg_type: type, topic: str) -> Publisher:
         return self.create_publisher(msg_type, topic, RELIABLE_10, event_callbacks=NO_PUB_EVENTS)
@@ -187,9 +193,29 @@ class StageRos(Node):
         self.sim.reset_positions()
         return response
 
+    def start_stepping(self) -> None:
+        """Step on the node's own timer from now on (for callers that built it with ``autostep=False``)."""
+        self.autostep = True
+        self.set_paused(self.paused)
+
+    def set_paused(self, paused: bool) -> None:
+        """Stop or resume stepping (the browser view's pause): sim time and /clock stand still meanwhile."""
+        self.paused = paused
+        if self.autostep and not self.finished:
+            if paused:
+                self._timer.cancel()
+            else:
+                self._timer.reset()
+
+    def set_speedup(self, speedup: float) -> None:
+        """Step at a new real-time factor from now on (``<= 0``: as fast as possible)."""
+        self.speedup = speedup
+        self.destroy_timer(self._timer)
+        self._timer = self._step_timer(self.autostep and not self.paused and not self.finished)
+
     def step_once(self) -> None:
-        """One simulation step and everything it publishes."""
-        if self.finished:
+        """One simulation step and everything it publishes (none while paused)."""
+        if self.finished or self.paused:
             return
         self.sim.step()
         self._publish_step()

@@ -1,7 +1,8 @@
-"""``stageros [-g] [-u] [--speedup X] [--seed N] [--kernels K] [--threads N] WORLD [--ros-args ...]``: run the node.
+"""``stageros [-g] [-u] [--view-*] [--speedup X] [--seed N] [--kernels K] [--threads N] WORLD [--ros-args ...]``.
 
-A broken world prints ``file:line:column: ...`` and exits with status 2 (no traceback); Ctrl-C and the
-world's ``quit_time`` end the node cleanly with status 0.
+Unless ``-g`` is given it serves the browser view (:mod:`stage_sim.ros.view`) and prints its URL. A broken
+world prints ``file:line:column: ...`` and exits with status 2 (no traceback); Ctrl-C and the world's
+``quit_time`` end the node cleanly with status 0.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import remove_ros_args
 
 from stage_sim.ros.recording import add_record_arguments, recording
+from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.worldfile.bundled import bundled_worlds
 from stage_sim.worldfile.errors import WorldError
@@ -28,7 +30,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog="stageros", description="Simulate a Stage world and publish it like stage_ros' stageros.",
         epilog=f"bundled worlds: {', '.join(bundled_worlds()) or 'none installed'}")
-    parser.add_argument("-g", action="store_true", help="no GUI (accepted for compatibility; there is no GUI)")
+    add_view_options(parser)
     parser.add_argument("-u", action="store_true", dest="use_model_names",
                         help="name robots' topics and frames after their models instead of robot_<i>")
     parser.add_argument("--speedup", type=float, default=None,
@@ -54,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
                         kernels=args.kernels, threads=args.threads)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        with recording(node, args, "stageros"):
+        with recording(node, args, "stageros"), viewing(node, args):
             while rclpy.ok() and not node.finished:
                 executor.spin_once(timeout_sec=0.1)
         return 0

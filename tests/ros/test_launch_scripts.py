@@ -20,7 +20,7 @@ KEYS = {"robot", "sim_seconds", "distance_m", "stall_events", "longest_stop_s", 
 
 
 def run_script(name: str, *args: str, cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, str(SCRIPTS / name), *args], cwd=cwd, capture_output=True, text=True,
+    return subprocess.run([sys.executable, str(SCRIPTS / name), "-g", *args], cwd=cwd, capture_output=True, text=True,
                           timeout=timeout, env=dict(os.environ))
 
 
@@ -75,7 +75,7 @@ def test_record_writes_one_frame_per_interval(tmp_path: Path) -> None:
 
 
 def test_ctrl_c_still_prints_the_summaries(tmp_path: Path) -> None:
-    process = subprocess.Popen([sys.executable, str(SCRIPTS / "reactive.py"), "--speedup", "2"], cwd=tmp_path,
+    process = subprocess.Popen([sys.executable, str(SCRIPTS / "reactive.py"), "-g", "--speedup", "2"], cwd=tmp_path,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dict(os.environ))
     time.sleep(6.0)
     process.send_signal(signal.SIGINT)
@@ -100,7 +100,7 @@ def test_teleop_session_drives_from_the_keyboard_and_restores_the_terminal(tmp_p
     master, slave = pty.openpty()
     before = termios.tcgetattr(slave)
     png = tmp_path / "last.png"
-    process = subprocess.Popen([sys.executable, str(SCRIPTS / "teleop.py"), "--speedup", "4", "--duration", "6",
+    process = subprocess.Popen([sys.executable, str(SCRIPTS / "teleop.py"), "-g", "--speedup", "4", "--duration", "6",
                                 "--record", str(png)], cwd=tmp_path, stdin=slave, stdout=slave,
                                stderr=subprocess.PIPE, text=True, env=dict(os.environ))
     try:

@@ -27,7 +27,7 @@ STAGEROS = Path(sys.executable).with_name("stageros")
 def start_stageros(cwd: Path, *args: str) -> subprocess.Popen:
     """The console script on the bundled rooms world, from a directory that does not hold it."""
     return subprocess.Popen(
-        [str(STAGEROS), *args, "rooms.world"], cwd=cwd, env=dict(os.environ),
+        [str(STAGEROS), "-g", *args, "rooms.world"], cwd=cwd, env=dict(os.environ),
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
 
@@ -169,7 +169,7 @@ def test_a_broken_world_exits_2_with_its_location_and_no_traceback(tmp_path) -> 
 
 
 def test_a_missing_world_names_the_bundled_ones(tmp_path) -> None:
-    result = subprocess.run([str(STAGEROS), "no_such.world"], capture_output=True, text=True, timeout=60,
+    result = subprocess.run([str(STAGEROS), "-g", "no_such.world"], capture_output=True, text=True, timeout=60,
                             cwd=tmp_path, env=dict(os.environ))
     assert result.returncode == 2
     assert "rooms.world" in result.stderr and "Traceback" not in result.stderr
@@ -178,7 +178,7 @@ def test_a_missing_world_names_the_bundled_ones(tmp_path) -> None:
 def test_quit_time_ends_the_node_cleanly(tmp_path) -> None:
     world = tmp_path / "short.world"
     world.write_text('quit_time 3\nresolution 0.02\nmodel( size [1 1 1] pose [3 0 0 0] )\nposition( pose [0 0 0 0] )\n')
-    result = subprocess.run([str(STAGEROS), "--speedup", "0", str(world)], capture_output=True, text=True,
+    result = subprocess.run([str(STAGEROS), "-g", "--speedup", "0", str(world)], capture_output=True, text=True,
                             timeout=60, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
     assert "quit_time 3 s reached" in result.stderr + result.stdout
@@ -190,7 +190,7 @@ def test_record_writes_a_gif_of_the_run(tmp_path) -> None:
     world = tmp_path / "short.world"
     world.write_text('quit_time 2\nresolution 0.02\nmodel( size [1 1 1] pose [3 0 0 0] )\nposition( pose [0 0 0 0] )\n')
     gif = tmp_path / "run.gif"
-    result = subprocess.run([str(STAGEROS), "--speedup", "0", "--record", str(gif), "--record-every", "0.5",
+    result = subprocess.run([str(STAGEROS), "-g", "--speedup", "0", "--record", str(gif), "--record-every", "0.5",
                              str(world)], capture_output=True, text=True, timeout=60, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
     with Image.open(gif) as image:

@@ -1,0 +1,69 @@
+"""``stage_sim view WORLD [--controller wander] [--speedup X]``: run a world live in the browser, without ROS.
+
+Prints ``view: http://127.0.0.1:PORT/`` once and steps the world in real time × ``--speedup`` until
+Ctrl-C (or ``--duration`` sim seconds). Commands from the page's keys stop after ``--watchdog`` sim seconds
+without a new one, as ``stageros``' ``base_watchdog_timeout`` does.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+from typing import Any
+
+from stage_sim.cli.arguments import resolve_world
+from stage_sim.view.options import add_view_arguments
+
+WATCHDOG_S = 0.2
+"""stageros' default ``base_watchdog_timeout``."""
+
+
+def run(args: argparse.Namespace) -> int:
+    from stage_sim.sim.simulation import Simulation
+    from stage_sim.view import LiveView, PacedLoop, view_settings
+
+    sim = Simulation.from_world(resolve_world(args.world), seed=args.seed, watchdog_timeout=args.watchdog)
+    for warning in sim.warnings:
+        print(f"stage_sim view: {warning}", file=sys.stderr)
+    before_step = None
+    if args.controller == "wander":
+        from stage_sim.runs.driver import WanderDriver
+
+        before_step = WanderDriver(sim, args.seed).decide
+    speedup = sim.description.settings.speedup if args.speedup is None else args.speedup
+    loop = PacedLoop(sim, speedup, before_step)
+    view = LiveView(sim, loop, view_settings(args))
+    try:
+        view.start()
+    except OSError as exc:
+        print(f"stage_sim view: cannot serve the view: {exc}", file=sys.stderr)
+        return 1
+    stop = threading.Event()
+    previous = signal.signal(signal.SIGINT, lambda *_: stop.set())
+    try:
+        loop.run(stop, view, args.duration)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        view.close()
+    return 0
+
+
+def add_command(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "view", help="run a world live in the browser (no ROS): watch, drag, pause and drive the robots",
+        description="Simulate WORLD in real time and serve a page that shows it and controls it as Stage's "
+        "window does. Prints the page's URL; Ctrl-C stops.",
+    )
+    parser.add_argument("world", help="world file path, or the name of a bundled world")
+    parser.add_argument("--controller", choices=["none", "wander"], default="none",
+                        help="who drives: nobody but you (default), or the wander node's strategy on every robot")
+    parser.add_argument("--speedup", type=float, default=None,
+                        help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
+    parser.add_argument("--seed", type=int, default=None, help="seed for odometry errors, noise and the wanderer")
+    parser.add_argument("--watchdog", type=float, default=WATCHDOG_S,
+                        help=f"sim seconds a command lasts without a new one (default {WATCHDOG_S}; <= 0: forever)")
+    parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")
+    add_view_arguments(parser)
+    parser.set_defaults(run=run)
