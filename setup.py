@@ -22,7 +22,12 @@ setup(
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
     install_requires=["setuptools", "numpy", "pyyaml", "pillow"],
-    extras_require={"test": ["pytest"]},
+    extras_require={
+        "test": ["pytest"],
+        # Reinforcement-learning environments (stage_sim.envs); ray adds the scale-out example.
+        "rl": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy"],
+        "ray": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy", "ray>=2.9"],
+    },
     zip_safe=True,
     entry_points={
         "console_scripts": [

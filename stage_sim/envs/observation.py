@@ -1,0 +1,128 @@
+"""What an agent observes: its last k scans, where its goal is, how it moves; one flat float32 vector.
+
+Layout of one agent's vector (``D = k·B + 4`` for B beams)::
+
+    [0, k·B)     the last k scans of its first laser, oldest first, each range / range_max in [0, 1]
+    k·B          distance to the goal (m)
+    k·B + 1      bearing of the goal in the robot frame (rad, counter-clockwise from ahead, in [-π, π])
+    k·B + 2      forward speed (m/s) the robot moved at in the last step (0 while stalled)
+    k·B + 3      turn rate (rad/s) of the last step
+
+Every agent's vector is computed in one batch over all agents (no per-agent Python loop).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from gymnasium import spaces
+
+from stage_sim.sim.robots import RobotSpec
+from stage_sim.sim.simulation import Simulation
+
+#: Entries after the scans: goal distance, goal bearing, forward speed, turn rate.
+TAIL = 4
+
+
+@dataclass(frozen=True)
+class ObservationLayout:
+    """Shape and meaning of an observation, so that a policy can read one (see the module docstring)."""
+
+    history: int
+    beams: int
+    range_max: float
+    fov: float
+    max_distance: float
+
+    @property
+    def size(self) -> int:
+        """Length of one observation vector."""
+        return self.history * self.beams + TAIL
+
+    @property
+    def beam_angles(self) -> np.ndarray:
+        """Direction of every beam in the robot frame (rad, counter-clockwise from −fov/2)."""
+        if self.beams == 1:
+            return np.zeros(1)
+        return -self.fov / 2 + np.arange(self.beams) * (self.fov / (self.beams - 1))
+
+    def latest_scan(self, observations: np.ndarray) -> np.ndarray:
+        """The newest scan (normalised ranges) of each observation row (..., D) → (..., B)."""
+        end = self.history * self.beams
+        return observations[..., end - self.beams:end]
+
+    def goal(self, observations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Goal (distance, bearing) of each observation row."""
+        end = self.history * self.beams
+        return observations[..., end], observations[..., end + 1]
+
+    def space(self, bounds: np.ndarray) -> spaces.Box:
+        """The observation space for a robot with ``velocity_bounds`` ``bounds`` (8,)."""
+        scans = self.history * self.beams
+        low = np.concatenate([np.zeros(scans), [0.0, -np.pi, bounds[0], bounds[6]]]).astype(np.float32)
+        high = np.concatenate([np.ones(scans), [self.max_distance, np.pi, bounds[1], bounds[7]]]).astype(np.float32)
+        return spaces.Box(low, high, dtype=np.float32)
+
+
+def layout_for(sim: Simulation, agents: list[int], history: int) -> ObservationLayout:
+    """The one layout every agent of ``sim`` shares; a clear error when their lasers differ or are missing."""
+    lasers = {(r.rangers[0].sensor.samples, r.rangers[0].sensor.range_max, r.rangers[0].sensor.fov)
+              for r in _agents(sim, agents)}
+    if len(lasers) != 1:
+        raise ValueError(f"the agents' first lasers differ (samples, range, fov: {sorted(lasers)}): "
+                         "one observation layout needs one kind of laser")
+    samples, range_max, fov = lasers.pop()
+    height, width = sim.static.shape
+    diagonal = float(np.hypot(height, width) * sim.static.resolution)
+    return ObservationLayout(history, samples, range_max, fov, diagonal)
+
+
+class ObservationBuilder:
+    """Keeps every agent's scan history and turns the simulation state into observation rows."""
+
+    def __init__(self, layout: ObservationLayout, agents: list[int], space: spaces.Box) -> None:
+        self.layout = layout
+        self.agents = np.asarray(agents, dtype=np.int64)
+        # A goal beyond the world's diagonal cannot happen; clipping the tail to the space is a guard.
+        self._tail_low = space.low[-TAIL:].astype(np.float64)
+        self._tail_high = space.high[-TAIL:].astype(np.float64)
+        self._history = np.zeros((len(agents), layout.history, layout.beams), dtype=np.float32)
+
+    def reset(self, sim: Simulation) -> None:
+        """Fill every agent's history with its current scan (no older scan exists yet)."""
+        self._history[:] = self._scans(sim)[:, None, :]
+
+    def observe(self, sim: Simulation, goals: np.ndarray) -> np.ndarray:
+        """Shift in the current scans and return (A, D) observations."""
+        self._history[:, :-1] = self._history[:, 1:]
+        self._history[:, -1] = self._scans(sim)
+        return self.rows(sim, goals)
+
+    def rows(self, sim: Simulation, goals: np.ndarray) -> np.ndarray:
+        """(A, D) observations from the kept history and the current poses and velocities."""
+        distance, bearing = goal_polar(sim.true_poses[self.agents], goals)
+        velocity = sim.velocities[self.agents]
+        tail = np.column_stack([distance, bearing, velocity[:, 0], velocity[:, 2]])
+        clipped = np.clip(tail, self._tail_low, self._tail_high)
+        return np.concatenate([self._history.reshape(len(self.agents), -1), clipped], axis=1).astype(np.float32)
+
+    def _scans(self, sim: Simulation) -> np.ndarray:
+        ranges = np.stack([sim.scans[i][0].ranges for i in self.agents])
+        return np.clip(ranges / self.layout.range_max, 0.0, 1.0).astype(np.float32)
+
+
+def goal_polar(poses: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance and robot-frame bearing (wrapped to [-π, π]) of each goal from each pose."""
+    delta = goals - poses[:, :2]
+    distance = np.hypot(delta[:, 0], delta[:, 1])
+    bearing = np.arctan2(delta[:, 1], delta[:, 0]) - poses[:, 2]
+    return distance, np.arctan2(np.sin(bearing), np.cos(bearing))
+
+
+def _agents(sim: Simulation, agents: list[int]) -> list[RobotSpec]:
+    robots = [sim.robots[i] for i in agents]
+    bare = [r.name for r in robots if not r.rangers or not r.rangers[0].sensor.samples]
+    if bare:
+        raise ValueError(f"robots without a laser cannot be agents: {', '.join(bare)}")
+    return robots
