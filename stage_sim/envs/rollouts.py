@@ -9,11 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import gymnasium
 import numpy as np
 
 from stage_sim.envs.baseline import GoalSeeker
+from stage_sim.envs.navigate import NavigateEnv
 from stage_sim.envs.parallel import NavigateParallelEnv
 from stage_sim.envs.task import NavigationTask
 
@@ -79,6 +81,40 @@ def run_parallel(env: NavigateParallelEnv, seed: int | None, policy: Policy | No
             time_to_goal += info["time"] * info["arrived"]
         observations = {name: observations[name] for name in env.agents}
     return EpisodeStats(len(env.possible_agents), arrived, collided, time_to_goal, total, steps)
+
+
+def run_vector(envs: gymnasium.vector.VectorEnv, seeds: list[int], policy: Policy) -> list[EpisodeStats]:
+    """The first episode of every sub-environment of a vector env of :class:`NavigateEnv` (e.g. an
+    ``AsyncVectorEnv``, one process per world), sub-environment i seeded with ``seeds[i]``; ``policy``
+    maps the batch of observations to the batch of actions (cast to the action space's dtype, as
+    :func:`run_single` does, so that both runs feed the simulation the same numbers)."""
+    observations, _ = envs.reset(seed=list(seeds))
+    count = len(seeds)
+    running = np.ones(count, dtype=bool)
+    totals, steps = np.zeros(count), np.zeros(count, dtype=np.int64)
+    stats: list[EpisodeStats | None] = [None] * count
+    while running.any():
+        actions = np.asarray(policy(observations), dtype=envs.single_action_space.dtype)
+        observations, rewards, terminated, truncated, infos = envs.step(actions)
+        totals += rewards * running
+        steps += running
+        for i in np.flatnonzero(running & (terminated | truncated)):
+            arrived = int(infos["arrived"][i])
+            stats[i] = EpisodeStats(1, arrived, int(infos["collided"][i]), float(infos["time"][i]) * arrived,
+                                    float(totals[i]), int(steps[i]))
+            running[i] = False
+    return [s for s in stats if s is not None]
+
+
+def run_spec(spec: dict[str, Any], seed: int) -> EpisodeStats:
+    """One baseline episode of the environment ``spec`` describes: its keyword arguments, plus ``"env"``:
+    ``"parallel"`` (the default) or ``"single"``. Plain data in, plain data out: a Ray task or a process
+    pool can run it anywhere ``stage_sim[rl]`` is installed."""
+    options = dict(spec)
+    kind = options.pop("env", "parallel")
+    if kind == "single":
+        return run_single(NavigateEnv(**options), seed)
+    return run_parallel(NavigateParallelEnv(**options), seed)
 
 
 def summarise(episodes: Iterable[EpisodeStats]) -> dict[str, float]:
