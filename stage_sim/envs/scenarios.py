@@ -75,6 +75,7 @@ class Scenario:
             description = self._load("")
         self.base = description
         self._base_space: FreeSpace | None = None
+        self._space: tuple[Simulation, FreeSpace] | None = None
 
     @property
     def changes_world(self) -> bool:
@@ -101,7 +102,10 @@ class Scenario:
         """Start poses (A, 3) and goals (A, 2) of the agents; other robots stay where the world put them."""
         if self.options.scenario == "circle":
             return self._circle(len(agents), rng)
-        space = FreeSpace(sim, agents, self.options.clearance)
+        if self._space is None or self._space[0] is not sim:
+            # The static world of a simulation never changes: its free space is worked out once.
+            self._space = (sim, FreeSpace(sim, agents, self.options.clearance))
+        space = self._space[1]
         others = np.array([r.start[:2] for r in sim.robots if r.index not in agents]).reshape(-1, 2)
         return space.starts_and_goals(rng, len(agents), others, self.options.min_goal_distance)
 
