@@ -93,12 +93,12 @@ def baseline(episodes: int) -> list[dict]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="wall seconds per speed measurement")
-    parser.add_argument("--episodes", type=int, default=10, help="seeds per baseline scenario")
+    parser.add_argument("--episodes", type=int, default=10, help="seeds per baseline scenario (0: speed only)")
     args = parser.parse_args()
     print(json.dumps(single_speed(args.seconds)), flush=True)
     for robots in (10, 100):
         print(json.dumps(parallel_speed(robots, args.seconds)), flush=True)
-    for row in baseline(args.episodes):
+    for row in baseline(args.episodes) if args.episodes > 0 else []:
         print(json.dumps({k: round(v, 3) if isinstance(v, float) else v for k, v in row.items()}), flush=True)
 
 

@@ -81,12 +81,12 @@ def layout_for(sim: Simulation, agents: list[int], history: int) -> ObservationL
 class ObservationBuilder:
     """Keeps every agent's scan history and turns the simulation state into observation rows."""
 
-    def __init__(self, layout: ObservationLayout, agents: list[int], space: spaces.Box) -> None:
+    def __init__(self, layout: ObservationLayout, agents: list[int], agent_spaces: list[spaces.Box]) -> None:
         self.layout = layout
         self.agents = np.asarray(agents, dtype=np.int64)
-        # A goal beyond the world's diagonal cannot happen; clipping the tail to the space is a guard.
-        self._tail_low = space.low[-TAIL:].astype(np.float64)
-        self._tail_high = space.high[-TAIL:].astype(np.float64)
+        # A goal beyond the world's diagonal cannot happen; clipping the tail to the spaces is a guard.
+        self._tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float64)
+        self._tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float64)
         self._history = np.zeros((len(agents), layout.history, layout.beams), dtype=np.float32)
 
     def reset(self, sim: Simulation) -> None:

@@ -65,7 +65,7 @@ class NavigationTask:
         bounds = np.array([self._base.robots[a].settings.velocity_bounds for a in self.agents])
         self.actions = ActionMap(bounds, config.discrete)
         self.observation_spaces = [self.layout.space(b) for b in bounds]
-        self._observer = ObservationBuilder(self.layout, self.agents, self.observation_spaces[0])
+        self._observer = ObservationBuilder(self.layout, self.agents, self.observation_spaces)
         count = len(self.agents)
         self.goals = np.zeros((count, 2))
         self.active = np.zeros(count, dtype=bool)
