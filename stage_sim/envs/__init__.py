@@ -13,7 +13,7 @@ import gymnasium
 from stage_sim.envs.baseline import GoalSeeker
 from stage_sim.envs.navigate import NavigateEnv
 from stage_sim.envs.parallel import NavigateParallelEnv
-from stage_sim.envs.reward import RewardConfig
+from stage_sim.envs.task import RewardConfig
 from stage_sim.envs.worlds import RobotBody
 
 ENV_ID = "stage_sim/Navigate-v0"

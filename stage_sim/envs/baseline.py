@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stage_sim.envs.observation import ObservationLayout
+from stage_sim.envs.spaces import ObservationLayout
 
 #: The scan is pooled (nearest range) into this many sectors before the gaps are searched.
 SECTORS = 90

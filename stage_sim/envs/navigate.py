@@ -1,7 +1,7 @@
 """``stage_sim/Navigate-v0``: one robot of a Stage world drives to a goal (Gymnasium).
 
-Observation, action and reward: see :mod:`stage_sim.envs.observation`, :mod:`stage_sim.envs.actions` and
-:mod:`stage_sim.envs.reward`; scenarios and their options: :mod:`stage_sim.envs.scenarios`. Importing
+Observation and action: see :mod:`stage_sim.envs.spaces`; reward: :mod:`stage_sim.envs.task`; scenarios
+and their options: :mod:`stage_sim.envs.scenarios`. Importing
 :mod:`stage_sim.envs` registers the id, so ``gymnasium.make("stage_sim/Navigate-v0", world="rooms.world")``
 works after it.
 """
@@ -13,9 +13,8 @@ from typing import Any, ClassVar
 import gymnasium
 import numpy as np
 
-from stage_sim.envs.reward import RewardConfig
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
-from stage_sim.envs.task import NavigationTask, StepResult, TaskConfig
+from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig
 
 
 class NavigateEnv(gymnasium.Env):
@@ -59,6 +58,4 @@ class NavigateEnv(gymnasium.Env):
         """The world as Stage's window shows it, an (H, W, 3) uint8 array (``render_mode="rgb_array"``)."""
         if self.render_mode != "rgb_array":
             return None
-        from stage_sim.envs.picture import picture
-
-        return picture(self.task.sim, self.task.goals, self.task.agents)
+        return self.task.frame()

@@ -14,10 +14,8 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from stage_sim.envs.picture import picture
-from stage_sim.envs.reward import RewardConfig
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
-from stage_sim.envs.task import NavigationTask, TaskConfig
+from stage_sim.envs.task import NavigationTask, RewardConfig, TaskConfig
 
 
 class NavigateParallelEnv(ParallelEnv):
@@ -84,7 +82,7 @@ class NavigateParallelEnv(ParallelEnv):
         """The world with every goal marked, an (H, W, 3) uint8 array (``render_mode="rgb_array"``)."""
         if self.render_mode != "rgb_array":
             return None
-        return picture(self.task.sim, self.task.goals, self.task.agents)
+        return self.task.frame()
 
     def state(self) -> np.ndarray:
         """Global state: every agent's true pose (x, y, yaw) and goal (x, y), one row each, flattened."""

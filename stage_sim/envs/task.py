@@ -3,6 +3,11 @@
 One :meth:`NavigationTask.step` commands every active agent, advances the simulation once (all robots move
 and all lasers are cast in that one call) and computes observations, rewards and episode ends for all
 agents with array operations. Agents whose episode ended stand still and stay in the world as obstacles.
+
+Reward per agent per step:
+``progress · (d_before − d_after) + arrival · [arrived] − collision · [collided] − time``, d the distance to
+the goal; an agent has *arrived* when d ≤ ``goal_tolerance`` and has *collided* when its last move was
+refused (Stage's stall). Either ends its episode (terminated); the step limit truncates it.
 """
 
 from __future__ import annotations
@@ -11,14 +16,43 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stage_sim.envs.actions import ActionMap
-from stage_sim.envs.observation import ObservationBuilder, goal_polar, layout_for
-from stage_sim.envs.reward import RewardConfig, score
 from stage_sim.envs.scenarios import Scenario
+from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar, layout_for
 from stage_sim.sim.simulation import Simulation
 
 #: Seeds handed to the simulation are drawn below this bound from the episode's generator.
 SEED_BOUND = 2**63
+#: Half the size of the cross that marks a goal in a frame, in metres.
+GOAL_MARK = 0.15
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """Weights of the reward terms and the arrival radius (m)."""
+
+    progress: float = 1.0
+    arrival: float = 10.0
+    collision: float = 10.0
+    time: float = 0.01
+    goal_tolerance: float = 0.3
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """Per agent: reward, arrived, collided (all (A,) arrays)."""
+
+    reward: np.ndarray
+    arrived: np.ndarray
+    collided: np.ndarray
+
+
+def score(config: RewardConfig, before: np.ndarray, after: np.ndarray, stalled: np.ndarray) -> StepOutcome:
+    """Rewards for one step from the goal distances before and after it and the stall flags."""
+    arrived = after <= config.goal_tolerance
+    collided = stalled & ~arrived
+    reward = (config.progress * (before - after) + config.arrival * arrived - config.collision * collided
+              - config.time)
+    return StepOutcome(reward.astype(np.float64), arrived, collided)
 
 
 @dataclass(frozen=True)
@@ -105,3 +139,20 @@ class NavigationTask:
         self.active &= ~(terminated | truncated)
         return StepResult(observations, outcome.reward * active, terminated, truncated,
                           outcome.arrived & active, outcome.collided & active, self.distance, active)
+
+    def frame(self) -> np.ndarray:
+        """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""
+        from PIL import Image, ImageDraw
+
+        from stage_sim.rendering import palette, render, renderer_for
+
+        picture = Image.fromarray(render(self.sim))
+        view = renderer_for(self.sim).view()
+        draw = ImageDraw.Draw(picture)
+        width = max(1, round(view.scale * 0.03))
+        for agent, goal in zip(self.agents, self.goals, strict=True):
+            ink = palette.blend(self.sim.robots[agent].model.color)
+            for diagonal in (np.array([1.0, 1.0]), np.array([1.0, -1.0])):
+                ends = np.array([goal - GOAL_MARK * diagonal, goal + GOAL_MARK * diagonal])
+                draw.line(view.continuous(ends).ravel().tolist(), fill=ink, width=width)
+        return np.asarray(picture)

@@ -12,7 +12,7 @@ from gymnasium.utils.env_checker import check_env
 import stage_sim.envs  # noqa: F401  (registers stage_sim/Navigate-v0)
 from stage_sim.envs import ENV_ID, NavigateEnv, RewardConfig, RobotBody
 from stage_sim.envs.free_space import PlacementError
-from stage_sim.envs.observation import goal_polar
+from stage_sim.envs.spaces import goal_polar
 from stage_sim.worldfile.errors import WorldError
 
 SMALL = RobotBody(laser_samples=32)

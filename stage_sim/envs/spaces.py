@@ -1,6 +1,6 @@
-"""What an agent observes: its last k scans, where its goal is, how it moves; one flat float32 vector.
+"""What an agent observes and what it commands: the observation layout and the action map.
 
-Layout of one agent's vector (``D = k·B + 4`` for B beams)::
+Observation: one flat float32 vector per agent (``D = k·B + 4`` for B beams)::
 
     [0, k·B)     the last k scans of its first laser, oldest first, each range / range_max in [0, 1]
     k·B          distance to the goal (m)
@@ -8,7 +8,12 @@ Layout of one agent's vector (``D = k·B + 4`` for B beams)::
     k·B + 2      forward speed (m/s) the robot moved at in the last step (0 while stalled)
     k·B + 3      turn rate (rad/s) of the last step
 
-Every agent's vector is computed in one batch over all agents (no per-agent Python loop).
+Action: a forward speed and a turn rate, continuous within the robot's ``velocity_bounds``, or (the
+discrete variant) one pair of a forward fraction in :data:`FORWARD` and a turn fraction in :data:`TURN` of
+the bounds' upper limits, forward fractions first: action ``i`` is
+``(FORWARD[i // len(TURN)] · v_max, TURN[i % len(TURN)] · ω_max)``, clamped into the bounds.
+
+Both are computed in one batch over all agents (no per-agent Python loop).
 """
 
 from __future__ import annotations
@@ -23,6 +28,9 @@ from stage_sim.sim.simulation import Simulation
 
 #: Entries after the scans: goal distance, goal bearing, forward speed, turn rate.
 TAIL = 4
+#: Fractions of the upper velocity bounds that make the discrete actions.
+FORWARD = (0.0, 0.5, 1.0)
+TURN = (-1.0, -0.5, 0.0, 0.5, 1.0)
 
 
 @dataclass(frozen=True)
@@ -126,3 +134,33 @@ def _agents(sim: Simulation, agents: list[int]) -> list[RobotSpec]:
     if bare:
         raise ValueError(f"robots without a laser cannot be agents: {', '.join(bare)}")
     return robots
+
+
+class ActionMap:
+    """Turns the actions of A agents (each with its robot's ``velocity_bounds``, (A, 8)) into (v, ω), batched."""
+
+    def __init__(self, bounds: np.ndarray, discrete: bool) -> None:
+        self.discrete = discrete
+        self.low = np.asarray(bounds, dtype=np.float64)[:, [0, 6]]
+        self.high = np.asarray(bounds, dtype=np.float64)[:, [1, 7]]
+        fractions = np.array([(f, t) for f in FORWARD for t in TURN])
+        self.table = np.clip(fractions[None] * self.high[:, None], self.low[:, None], self.high[:, None])
+
+    def space(self, agent: int) -> spaces.Space:
+        """``Box([v_min, ω_min], [v_max, ω_max])`` or ``Discrete(len(FORWARD) · len(TURN))`` for agent ``agent``."""
+        if self.discrete:
+            return spaces.Discrete(self.table.shape[1])
+        return spaces.Box(self.low[agent].astype(np.float32), self.high[agent].astype(np.float32), dtype=np.float32)
+
+    def commands(self, actions: np.ndarray) -> np.ndarray:
+        """(A, 2) commands (v, ω) from one action per agent; continuous ones are clamped into the bounds."""
+        if self.discrete:
+            chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
+            return self.table[np.arange(len(chosen)), chosen]
+        return np.clip(np.asarray(actions, dtype=np.float64).reshape(-1, 2), self.low, self.high)
+
+    def nearest(self, commands: np.ndarray) -> np.ndarray:
+        """The discrete action closest to each agent's wanted (v, ω), for scripted policies."""
+        scale = np.maximum(self.high - self.low, 1e-9)[:, None]
+        gaps = np.linalg.norm((commands[:, None, :] - self.table) / scale, axis=-1)
+        return np.argmin(gaps, axis=1)
