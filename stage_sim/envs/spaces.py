@@ -87,37 +87,42 @@ def layout_for(sim: Simulation, agents: list[int], history: int) -> ObservationL
 
 
 class ObservationBuilder:
-    """Keeps every agent's scan history and turns the simulation state into observation rows."""
+    """Keeps every agent's scan history and writes observation rows straight into one float32 array."""
 
     def __init__(self, layout: ObservationLayout, agents: list[int], agent_spaces: list[spaces.Box]) -> None:
         self.layout = layout
         self.agents = np.asarray(agents, dtype=np.int64)
         # A goal beyond the world's diagonal cannot happen; clipping the tail to the spaces is a guard.
-        self._tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float64)
-        self._tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float64)
+        self._tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float32)
+        self._tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float32)
         self._history = np.zeros((len(agents), layout.history, layout.beams), dtype=np.float32)
 
     def reset(self, sim: Simulation) -> None:
         """Fill every agent's history with its current scan (no older scan exists yet)."""
-        self._history[:] = self._scans(sim)[:, None, :]
+        self._scan_into(sim, self._history[:, -1])
+        self._history[:, :-1] = self._history[:, -1:]
 
-    def observe(self, sim: Simulation, goals: np.ndarray) -> np.ndarray:
-        """Shift in the current scans and return (A, D) observations."""
+    def observe(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
+        """Shift in the current scans and return (A, D) observations (goal distance and bearing given)."""
         self._history[:, :-1] = self._history[:, 1:]
-        self._history[:, -1] = self._scans(sim)
-        return self.rows(sim, goals)
+        self._scan_into(sim, self._history[:, -1])
+        return self.rows(sim, distance, bearing)
 
-    def rows(self, sim: Simulation, goals: np.ndarray) -> np.ndarray:
-        """(A, D) observations from the kept history and the current poses and velocities."""
-        distance, bearing = goal_polar(sim.true_poses[self.agents], goals)
+    def rows(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
+        """(A, D) observations from the kept history, the goals' distance and bearing and the velocities."""
+        count, scans = len(self.agents), self.layout.history * self.layout.beams
+        rows = np.empty((count, scans + TAIL), dtype=np.float32)
+        rows[:, :scans] = self._history.reshape(count, scans)
+        tail = rows[:, scans:]
         velocity = sim.velocities[self.agents]
-        tail = np.column_stack([distance, bearing, velocity[:, 0], velocity[:, 2]])
-        clipped = np.clip(tail, self._tail_low, self._tail_high)
-        return np.concatenate([self._history.reshape(len(self.agents), -1), clipped], axis=1).astype(np.float32)
+        tail[:, 0], tail[:, 1], tail[:, 2], tail[:, 3] = distance, bearing, velocity[:, 0], velocity[:, 2]
+        np.clip(tail, self._tail_low, self._tail_high, out=tail)
+        return rows
 
-    def _scans(self, sim: Simulation) -> np.ndarray:
-        ranges = np.stack([sim.scans[i][0].ranges for i in self.agents])
-        return np.clip(ranges / self.layout.range_max, 0.0, 1.0).astype(np.float32)
+    def _scan_into(self, sim: Simulation, out: np.ndarray) -> None:
+        """Each agent's newest scan, normalised by the range and clipped to [0, 1], into ``out`` (A, B)."""
+        np.divide(np.stack([sim.scans[i][0].ranges for i in self.agents]), self.layout.range_max, out=out)
+        np.clip(out, 0.0, 1.0, out=out)
 
 
 def goal_polar(poses: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

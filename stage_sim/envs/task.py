@@ -119,8 +119,8 @@ class NavigationTask:
         self._observer.reset(self.sim)
         self.active[:] = True
         self.steps = 0
-        self.distance = goal_polar(self.sim.true_poses[self.agents], self.goals)[0]
-        return self._observer.rows(self.sim, self.goals)
+        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        return self._observer.rows(self.sim, self.distance, bearing)
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
@@ -129,9 +129,9 @@ class NavigationTask:
             self.sim.set_velocity(agent, float(forward), 0.0, float(turn))
         self.sim.step()
         self.steps += 1
-        observations = self._observer.observe(self.sim, self.goals)
         before = self.distance
-        self.distance = goal_polar(self.sim.true_poses[self.agents], self.goals)[0]
+        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        observations = self._observer.observe(self.sim, self.distance, bearing)
         outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self.agents])
         active = self.active.copy()
         terminated = (outcome.arrived | outcome.collided) & active
