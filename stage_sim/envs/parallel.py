@@ -17,21 +17,27 @@ from pettingzoo import ParallelEnv
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, RewardConfig, TaskConfig
 
+#: Robots generated when neither ``n_robots`` nor a world with robots says how many.
+DEFAULT_ROBOTS = 4
+
 
 class NavigateParallelEnv(ParallelEnv):
-    """Every robot of a scenario's world is an agent (``n_robots`` generated ones, or the world's own)."""
+    """Every robot of a scenario's world is an agent: ``n_robots`` generated ones, else the world's own (a
+    generated arena or the circle gets :data:`DEFAULT_ROBOTS`)."""
 
     metadata: ClassVar[dict[str, Any]] = {
         "name": "stage_sim_navigate_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
     def __init__(
-        self, scenario: str = "circle", n_robots: int | None = 4, render_mode: str | None = None,
+        self, scenario: str = "circle", n_robots: int | None = None, render_mode: str | None = None,
         history: int = 3, max_steps: int = 500, discrete: bool = False, reward: RewardConfig | None = None,
         **options: Any,
     ) -> None:
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         config = TaskConfig(history, max_steps, discrete, reward or RewardConfig())
+        if n_robots is None and (scenario == "circle" or options.get("world") is None):
+            n_robots = DEFAULT_ROBOTS
         self.task = NavigationTask(Scenario(ScenarioOptions(scenario=scenario, n_robots=n_robots, **options)), config)
         self.layout = self.task.layout
         self.possible_agents = [f"robot_{i}" for i in self.task.agents]

@@ -123,3 +123,15 @@ def test_a_broken_world_reports_file_line_and_column(tmp_path):
     world.write_text("resolution 0.05\nmodel( size [1 1 )\n")
     with pytest.raises(WorldError, match=r"broken.world:2:"):
         make(world=str(world))
+
+
+def test_in_a_world_of_several_robots_the_chosen_one_drives_and_the_others_stand_clear_of_its_start_and_goal():
+    env = gymnasium.make(ENV_ID, world="multi_robots.world", robot=2, history=1).unwrapped
+    others = np.array([r.start[:2] for r in env.task.sim.robots if r.index != 2])
+    for seed in range(3):
+        _, info = env.reset(seed=seed)
+        start = env.task.sim.true_poses[2, :2]
+        clearance = 2 * env.task.sim.robots[2].radius
+        assert np.all(np.linalg.norm(others - start, axis=1) >= clearance)
+        assert np.all(np.linalg.norm(others - info["goal"], axis=1) >= clearance)
+        assert np.array_equal(env.task.sim.true_poses[[0, 1, 3], :2], others)

@@ -56,7 +56,7 @@ def test_an_agent_that_arrives_or_collides_leaves_and_its_robot_stays_put():
 
 
 def test_world_robots_become_agents_and_generated_ones_replace_them():
-    assert NavigateParallelEnv(scenario="random", n_robots=None, world="multi_robots.world").possible_agents == [
+    assert NavigateParallelEnv(scenario="random", world="multi_robots.world").possible_agents == [
         "robot_0", "robot_1", "robot_2", "robot_3"]
     env = NavigateParallelEnv(scenario="random", n_robots=3, world="rooms.world", body=SMALL)
     assert [r.name for r in env.task.sim.robots] == ["agent_0", "agent_1", "agent_2"]
@@ -81,7 +81,7 @@ def test_robots_with_different_lasers_cannot_share_an_observation_layout(tmp_pat
         'position( pose [1 1 0 0] ranger( sensor( samples 10 range [0 4] ) ) )\n'
         'simple_robot( pose [3 3 0 0] )\n'.replace("simple_robot.inc", str(_robots_folder() / "simple_robot.inc")))
     with pytest.raises(ValueError, match="lasers differ"):
-        NavigateParallelEnv(scenario="random", n_robots=None, world=str(world))
+        NavigateParallelEnv(scenario="random", world=str(world))
 
 
 def _robots_folder():
