@@ -6,7 +6,7 @@ import importlib.util
 from pathlib import Path
 
 import gymnasium
-import pytest
+import ray
 from gymnasium.vector import AsyncVectorEnv
 
 from stage_sim.envs import ENV_ID, RobotBody
@@ -33,7 +33,6 @@ def test_async_vector_env_with_two_workers_matches_a_serial_run():
 
 
 def test_the_ray_example_on_a_local_instance_matches_a_serial_run():
-    ray = pytest.importorskip("ray", reason="ray is pinned in requirements.lock; only a bare `pip install .` lacks it")
     spec = importlib.util.spec_from_file_location("ray_sweep", EXAMPLE)
     example = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(example)
