@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.envs.free_space import FreeSpace
-from stage_sim.envs.worlds import RobotBody, WorldSource, obstacles_text, robots_text
+from stage_sim.envs.worlds import RobotBody, WorldSource, obstacles_text, robots_text, world_centre
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.description import WorldDescription
 
@@ -67,12 +67,10 @@ class Scenario:
         if arena is None:
             arena = 2 * options.radius + 3.0 if options.scenario == "circle" else 10.0
         self.source = WorldSource.of(options.world, arena, options.resolution)
-        generated = options.n_robots if options.n_robots is not None else 0
-        self._robots = robots_text(generated, options.body) if generated else ""
-        description = self._load("")
-        if not description.robots():
-            self._robots = robots_text(1, options.body)
-            description = self._load("")
+        plain = self.source.load()
+        generated = options.n_robots if options.n_robots is not None else (0 if plain.robots() else 1)
+        self._robots = robots_text(generated, options.body, world_centre(plain)) if generated else ""
+        description = self._load("") if generated else plain
         self.base = description
         self._base_space: FreeSpace | None = None
         self._space: tuple[Simulation, FreeSpace] | None = None

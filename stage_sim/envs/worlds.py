@@ -68,10 +68,24 @@ def arena_text(size: float, resolution: float = 0.05, interval_sim: float = 0.1)
     return "\n".join(lines) + "\n"
 
 
-def robots_text(count: int, body: RobotBody) -> str:
-    """``count`` generated robots named ``agent_<i>``, stacked at the origin until a scenario places them."""
-    robots = [f'{ROBOT_DEFINE}( name "agent_{i}" pose [0 0 0 0] color "{_robot_color(i)}" )' for i in range(count)]
+def robots_text(count: int, body: RobotBody, at: tuple[float, float] = (0.0, 0.0)) -> str:
+    """``count`` generated robots named ``agent_<i>``, stacked at ``at`` until a scenario places them."""
+    x, y = at
+    robots = [f'{ROBOT_DEFINE}( name "agent_{i}" pose [{x:.4f} {y:.4f} 0 0] color "{_robot_color(i)}" )'
+              for i in range(count)]
     return body.define_text() + "\n".join(robots) + "\n"
+
+
+def world_centre(description: WorldDescription) -> tuple[float, float]:
+    """Middle of the top-level static models' boxes: a place inside the world for robots not yet placed
+    (the simulation's grid grows to hold every robot, so a far-off origin would make it needlessly big)."""
+    boxes = [(m.pose.x - m.size[0] / 2, m.pose.y - m.size[1] / 2, m.pose.x + m.size[0] / 2, m.pose.y + m.size[1] / 2)
+             for m in description.models if m.type != "position"]
+    if not boxes:
+        return (0.0, 0.0)
+    low_x, low_y, _, _ = np.min(boxes, axis=0)
+    _, _, high_x, high_y = np.max(boxes, axis=0)
+    return (float(low_x + high_x) / 2, float(low_y + high_y) / 2)
 
 
 def obstacles_text(boxes: np.ndarray) -> str:

@@ -88,3 +88,15 @@ def _robots_folder():
     from stage_sim.worldfile.bundled import data_root
 
     return data_root() / "robots"
+
+
+def test_generated_robots_join_a_world_far_from_the_origin_without_growing_its_grid(tmp_path):
+    walls = "".join(
+        f'model( size [{w} {h} 1] pose [{500 + x} {300 + y} 0 0] )\n'
+        for x, y, w, h in ((0, 4, 8, 0.1), (0, -4, 8, 0.1), (4, 0, 0.1, 8), (-4, 0, 0.1, 8)))
+    world = tmp_path / "far.world"
+    world.write_text("resolution 0.05\n" + walls)
+    env = NavigateParallelEnv(scenario="random", world=str(world), n_robots=2, body=SMALL)
+    assert max(env.task.sim.static.shape) < 200
+    env.reset(seed=0)
+    assert abs(env.task.sim.true_poses[:, :2] - (500, 300)).max() < 4
