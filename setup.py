@@ -24,7 +24,12 @@ setup(
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
     install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp"],
-    extras_require={"test": ["pytest", "playwright"]},
+    extras_require={
+        "test": ["pytest", "playwright"],
+        # Reinforcement-learning environments (stage_sim.envs); ray adds the scale-out example.
+        "rl": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy"],
+        "ray": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy", "ray>=2.9"],
+    },
     zip_safe=False,
     entry_points={
         "console_scripts": [

@@ -1,0 +1,158 @@
+"""The navigation task both environments wrap: A agents of one simulation, stepped and scored as arrays.
+
+One :meth:`NavigationTask.step` commands every active agent, advances the simulation once (all robots move
+and all lasers are cast in that one call) and computes observations, rewards and episode ends for all
+agents with array operations. Agents whose episode ended stand still and stay in the world as obstacles.
+
+Reward per agent per step:
+``progress · (d_before − d_after) + arrival · [arrived] − collision · [collided] − time``, d the distance to
+the goal; an agent has *arrived* when d ≤ ``goal_tolerance`` and has *collided* when its last move was
+refused (Stage's stall). Either ends its episode (terminated); the step limit truncates it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from stage_sim.envs.scenarios import Scenario
+from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar, layout_for
+from stage_sim.sim.simulation import Simulation
+
+#: Seeds handed to the simulation are drawn below this bound from the episode's generator.
+SEED_BOUND = 2**63
+#: Half the size of the cross that marks a goal in a frame, in metres.
+GOAL_MARK = 0.15
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """Weights of the reward terms and the arrival radius (m)."""
+
+    progress: float = 1.0
+    arrival: float = 10.0
+    collision: float = 10.0
+    time: float = 0.01
+    goal_tolerance: float = 0.3
+
+
+@dataclass(frozen=True)
+class StepOutcome:
+    """Per agent: reward, arrived, collided (all (A,) arrays)."""
+
+    reward: np.ndarray
+    arrived: np.ndarray
+    collided: np.ndarray
+
+
+def score(config: RewardConfig, before: np.ndarray, after: np.ndarray, stalled: np.ndarray) -> StepOutcome:
+    """Rewards for one step from the goal distances before and after it and the stall flags."""
+    arrived = after <= config.goal_tolerance
+    collided = stalled & ~arrived
+    reward = (config.progress * (before - after) + config.arrival * arrived - config.collision * collided
+              - config.time)
+    return StepOutcome(reward.astype(np.float64), arrived, collided)
+
+
+@dataclass(frozen=True)
+class TaskConfig:
+    """How episodes are observed, acted in, scored and cut short."""
+
+    history: int = 3
+    max_steps: int = 500
+    discrete: bool = False
+    reward: RewardConfig = field(default_factory=RewardConfig)
+
+    def __post_init__(self) -> None:
+        if self.history < 1 or self.max_steps < 1:
+            raise ValueError(f"history and max_steps must be at least 1, got {self.history} and {self.max_steps}")
+
+
+@dataclass
+class StepResult:
+    """Per agent (A,) arrays of one step; ``active`` tells which agents were still in the episode."""
+
+    observations: np.ndarray
+    rewards: np.ndarray
+    terminated: np.ndarray
+    truncated: np.ndarray
+    arrived: np.ndarray
+    collided: np.ndarray
+    distance: np.ndarray
+    active: np.ndarray
+
+
+class NavigationTask:
+    """Episodes of ``scenario`` for the robots ``agents`` (default: every robot of the world)."""
+
+    def __init__(self, scenario: Scenario, config: TaskConfig, agents: list[int] | None = None) -> None:
+        self.scenario = scenario
+        self.config = config
+        self._base = Simulation(scenario.base)
+        self.sim = self._base
+        self.agents = list(range(len(self._base.robots))) if agents is None else list(agents)
+        bad = [a for a in self.agents if not 0 <= a < len(self._base.robots)]
+        if bad or not self.agents:
+            raise ValueError(f"no robot {bad or '(none chosen)'} in a world of {len(self._base.robots)} robots")
+        self.layout = layout_for(self._base, self.agents, config.history)
+        bounds = np.array([self._base.robots[a].settings.velocity_bounds for a in self.agents])
+        self.actions = ActionMap(bounds, config.discrete)
+        self.observation_spaces = [self.layout.space(b) for b in bounds]
+        self._observer = ObservationBuilder(self.layout, self.agents, self.observation_spaces)
+        count = len(self.agents)
+        self.goals = np.zeros((count, 2))
+        self.active = np.zeros(count, dtype=bool)
+        self.distance = np.zeros(count)
+        self.steps = 0
+
+    def reset(self, rng: np.random.Generator) -> np.ndarray:
+        """A new episode drawn from ``rng``; returns the (A, D) first observations."""
+        if self.scenario.changes_world:
+            self.sim = Simulation(self.scenario.world(rng, self._base))
+        self.sim.reset(int(rng.integers(SEED_BOUND)))
+        starts, self.goals = self.scenario.place(self.sim, self.agents, rng)
+        for agent, start in zip(self.agents, starts, strict=True):
+            self.sim.set_pose(agent, *start)
+        # set_pose defers the lasers to the next step: one still step scans from the placed poses.
+        self.sim.step()
+        self._observer.reset(self.sim)
+        self.active[:] = True
+        self.steps = 0
+        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        return self._observer.rows(self.sim, self.distance, bearing)
+
+    def step(self, actions: np.ndarray) -> StepResult:
+        """Apply one action per agent (those of finished agents are ignored) and advance one step."""
+        commands = self.actions.commands(actions) * self.active[:, None]
+        for agent, (forward, turn) in zip(self.agents, commands, strict=True):
+            self.sim.set_velocity(agent, float(forward), 0.0, float(turn))
+        self.sim.step()
+        self.steps += 1
+        before = self.distance
+        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        observations = self._observer.observe(self.sim, self.distance, bearing)
+        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self.agents])
+        active = self.active.copy()
+        terminated = (outcome.arrived | outcome.collided) & active
+        truncated = ~terminated & active & (self.steps >= self.config.max_steps)
+        self.active &= ~(terminated | truncated)
+        return StepResult(observations, outcome.reward * active, terminated, truncated,
+                          outcome.arrived & active, outcome.collided & active, self.distance, active)
+
+    def frame(self) -> np.ndarray:
+        """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""
+        from PIL import Image, ImageDraw
+
+        from stage_sim.rendering import palette, render, renderer_for
+
+        picture = Image.fromarray(render(self.sim))
+        view = renderer_for(self.sim).view()
+        draw = ImageDraw.Draw(picture)
+        width = max(1, round(view.scale * 0.03))
+        for agent, goal in zip(self.agents, self.goals, strict=True):
+            ink = palette.blend(self.sim.robots[agent].model.color)
+            for diagonal in (np.array([1.0, 1.0]), np.array([1.0, -1.0])):
+                ends = np.array([goal - GOAL_MARK * diagonal, goal + GOAL_MARK * diagonal])
+                draw.line(view.continuous(ends).ravel().tolist(), fill=ink, width=width)
+        return np.asarray(picture)
