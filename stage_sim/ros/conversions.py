@@ -1,9 +1,12 @@
-"""Pure conversions from simulation state to ROS messages: no node, no publishing, easy to test."""
+"""Pure conversions from simulation state to ROS messages: no node, no publishing, easy to test.
+
+The values come from :mod:`stage_sim.bags.fields`, which the ROS-free bag writer uses too.
+"""
 
 from __future__ import annotations
 
-import math
 from array import array
+from dataclasses import asdict
 
 import numpy as np
 from builtin_interfaces.msg import Time
@@ -13,15 +16,16 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
+from stage_sim.bags import fields
 from stage_sim.sim.rangers import Scan
 from stage_sim.sim.robots import RangerSpec
-from stage_sim.worldfile.description import Pose
 from stage_sim.worldfile.occupancy import OccupancyGrid
 
 
 def stamp(sim_time_us: int) -> Time:
     """builtin_interfaces/Time of a sim time in integer microseconds (exact, no float rounding)."""
-    return Time(sec=sim_time_us // 1_000_000, nanosec=(sim_time_us % 1_000_000) * 1000)
+    sec, nanosec = fields.stamp_parts(sim_time_us)
+    return Time(sec=sec, nanosec=nanosec)
 
 
 def clock_msg(sim_time_us: int) -> Clock:
@@ -31,29 +35,23 @@ def clock_msg(sim_time_us: int) -> Clock:
 
 def yaw_quaternion(yaw: float) -> Quaternion:
     """Rotation about z by ``yaw`` radians."""
-    return Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+    x, y, z, w = fields.yaw_quaternion(yaw)
+    return Quaternion(x=x, y=y, z=z, w=w)
 
 
 def scan_msg(ranger: RangerSpec, frame_id: str) -> LaserScan:
     """A LaserScan with everything that never changes for this ranger: CCW from −fov/2, its range limits."""
-    sensor = ranger.sensor
-    msg = LaserScan()
+    msg = LaserScan(**asdict(fields.scan_geometry(ranger)))
     msg.header.frame_id = frame_id
-    msg.angle_min = -sensor.fov / 2
-    msg.angle_max = sensor.fov / 2
-    msg.angle_increment = sensor.fov / (sensor.samples - 1) if sensor.samples > 1 else 0.0
-    msg.time_increment = 0.0
-    msg.scan_time = ranger.update_interval
-    msg.range_min = sensor.range_min
-    msg.range_max = sensor.range_max
     return msg
 
 
 def fill_scan(msg: LaserScan, scan: Scan, time: Time) -> LaserScan:
     """Put one measurement into a ranger's message: a miss reads exactly range_max."""
     msg.header.stamp = time
-    msg.ranges = array("f", scan.ranges.astype(np.float32).tobytes())
-    msg.intensities = array("f", scan.intensities.astype(np.float32).tobytes())
+    ranges, intensities = fields.scan_arrays(scan)
+    msg.ranges = array("f", ranges.tobytes())
+    msg.intensities = array("f", intensities.tobytes())
     return msg
 
 
@@ -70,7 +68,7 @@ def fill_odometry(msg: Odometry, pose: np.ndarray, velocity: np.ndarray, time: T
     msg.header.stamp = time
     position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
     position.x, position.y = float(pose[0]), float(pose[1])
-    orientation.z, orientation.w = math.sin(pose[2] / 2), math.cos(pose[2] / 2)
+    _, _, orientation.z, orientation.w = fields.yaw_quaternion(pose[2])
     twist = msg.twist.twist
     twist.linear.x, twist.linear.y, twist.angular.z = float(velocity[0]), float(velocity[1]), float(velocity[2])
     return msg
@@ -80,7 +78,7 @@ def fill_planar_transform(t: TransformStamped, x: float, y: float, yaw: float, t
     """Move a planar TF edge (z = 0) to (x, y, yaw) at ``time``."""
     t.header.stamp = time
     t.transform.translation.x, t.transform.translation.y = float(x), float(y)
-    t.transform.rotation.z, t.transform.rotation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    _, _, t.transform.rotation.z, t.transform.rotation.w = fields.yaw_quaternion(yaw)
     return t
 
 
@@ -97,9 +95,9 @@ def transform(parent: str, child: str, x: float, y: float, z: float, yaw: float,
     return t
 
 
-def ranger_transform(parent: str, child: str, pose: Pose, time: Time) -> TransformStamped:
-    """``base_link → base_laser_link``: the ranger's pose on the robot (z already includes the robot height)."""
-    return transform(parent, child, pose.x, pose.y, pose.z, pose.yaw, time)
+def edge_transform(edge: fields.Edge, time: Time) -> TransformStamped:
+    """A fixed TF edge (/tf_static) at ``time``."""
+    return transform(edge.parent, edge.child, edge.x, edge.y, edge.z, edge.yaw, time)
 
 
 def occupancy_grid_msg(grid: OccupancyGrid, frame_id: str, time: Time) -> OccupancyGridMsg:

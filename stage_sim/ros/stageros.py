@@ -15,7 +15,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry
@@ -31,8 +30,9 @@ from std_msgs.msg import Bool
 from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
+from stage_sim.bags import fields
+from stage_sim.bags.names import RobotNames, robot_names
 from stage_sim.ros import conversions
-from stage_sim.ros.names import RobotNames, robot_names
 from stage_sim.sensing.kernels import resolve_threads
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world
@@ -42,8 +42,6 @@ from stage_sim.worldfile.loader import load_world
 ABSURD_COMMAND = 1e3
 # At most one warning per robot in this many wall seconds about rejected commands.
 WARNING_THROTTLE_S = 5.0
-# The world frame of ground truth and /map.
-WORLD_FRAME = "world"
 
 RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 # rclpy gives every publisher and subscription default QoS-event handlers, each a waitable the executor
@@ -139,7 +137,7 @@ class StageRos(Node):
         self._out = [
             _RobotMessages(
                 odom=conversions.odometry_msg(names.odom_frame, names.base_footprint),
-                truth=conversions.odometry_msg(WORLD_FRAME, names.base_footprint),
+                truth=conversions.odometry_msg(fields.WORLD_FRAME, names.base_footprint),
                 stall=Bool(),
                 odom_tf=conversions.transform(names.odom_frame, names.base_footprint, 0, 0, 0, 0, conversions.stamp(0)),
                 scans=[conversions.scan_msg(r, f) for r, f in zip(robot.rangers, names.laser_frames, strict=True)],
@@ -159,15 +157,11 @@ class StageRos(Node):
     def _publish_static(self) -> None:
         """One latched /tf_static message with every robot's fixed frames (and /map if asked)."""
         time = conversions.stamp(self.sim.sim_time_us)
-        transforms = []
-        for robot, names in zip(self.sim.robots, self.names, strict=True):
-            transforms.append(conversions.transform(names.base_footprint, names.base_link, 0, 0, 0, 0, time))
-            for ranger, frame in zip(robot.rangers, names.laser_frames, strict=True):
-                transforms.append(conversions.ranger_transform(names.base_link, frame, ranger.pose, time))
-        self.tf_static_pub.publish(TFMessage(transforms=transforms))
+        edges = fields.static_edges(self.sim.robots, self.names)
+        self.tf_static_pub.publish(TFMessage(transforms=[conversions.edge_transform(e, time) for e in edges]))
         if self.map_pub is not None:
             grid = self.sim.static.to_occupancy_grid()
-            self.map_pub.publish(conversions.occupancy_grid_msg(grid, WORLD_FRAME, time))
+            self.map_pub.publish(conversions.occupancy_grid_msg(grid, fields.WORLD_FRAME, time))
 
     # -- callbacks -----------------------------------------------------------------------------------------
 
@@ -230,7 +224,7 @@ class StageRos(Node):
         sim = self.sim
         time = conversions.stamp(sim.sim_time_us)
         self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
-        true_velocity = np.where(sim.stalled[:, None], 0.0, sim.velocities)
+        true_velocity = fields.ground_truth_velocities(sim)
         for i, out in enumerate(self._out):
             odom = sim.odometry_poses[i]
             self.odom_pubs[i].publish(conversions.fill_odometry(out.odom, odom, sim.velocities[i], time))
@@ -239,6 +233,6 @@ class StageRos(Node):
             self.stall_pubs[i].publish(out.stall)
             conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
             for scan, pub, msg in zip(sim.scans[i], self.scan_pubs[i], out.scans, strict=True):
-                if scan.stamp == sim.sim_time:
+                if fields.is_fresh(scan, sim):
                     pub.publish(conversions.fill_scan(msg, scan, time))
         self.tf_pub.publish(self._tf)
