@@ -23,9 +23,9 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
-    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp"],
+    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp", "mcap", "rosbags"],
     extras_require={
-        "test": ["pytest", "playwright"],
+        "test": ["pytest", "playwright", "mcap-ros2-support"],
         # Reinforcement-learning environments (stage_sim.envs); ray adds the scale-out example.
         "rl": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy"],
         "ray": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy", "ray>=2.9"],

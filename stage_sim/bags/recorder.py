@@ -1,0 +1,137 @@
+"""Record a running simulation into an MCAP bag without holding up its steps.
+
+After every step the stepping thread copies what the step published (:class:`StepState`) into a bounded
+queue and goes on; a writer thread builds, serialises and writes the messages. When the queue is full (the
+disk or the writer cannot keep up) the step is dropped, counted, and the count is said at exit and stored
+in the bag's ``stage_sim`` metadata record. A write error (full disk, file size limit) stops the recording
+with one message on stderr; the simulation goes on and the file stays readable up to its last chunk.
+"""
+
+from __future__ import annotations
+
+import queue
+import sys
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+from stage_sim.bags.container import McapBag
+from stage_sim.bags.errors import BagError
+from stage_sim.bags.messages import TYPESTORE, MessageBuilder, StepState
+from stage_sim.bags.names import RobotNames
+from stage_sim.bags.topics import MAP, robot_topics, select, stageros_topics
+from stage_sim.sim.simulation import Simulation
+
+QUEUE_BYTES = 64 * 1024 * 1024
+"""Memory the queue of pending steps may hold (ranges and intensities dominate: 8 bytes per beam)."""
+LIBRARY = "stage_sim bags (mcap + rosbags)"
+
+
+@dataclass(frozen=True)
+class BagSummary:
+    """What a recording wrote and lost, for the message at exit."""
+
+    path: Path
+    messages: int
+    dropped_steps: int
+    dropped_messages: int
+    error: str | None
+
+    def describe(self) -> str:
+        """One line for the user."""
+        text = f"bag {self.path}: {self.messages} messages"
+        if self.dropped_steps:
+            text += (f"; dropped {self.dropped_messages} messages of {self.dropped_steps} steps because the disk "
+                     "could not keep up (see the 'stage_sim' metadata record)")
+        if self.error:
+            text += f"; recording stopped early: {self.error} (recover the rest with: stage_sim recover {self.path})"
+        return text
+
+
+class BagRecorder:
+    """Records every step of ``sim`` (call :meth:`record_step` after each) until :meth:`close`."""
+
+    def __init__(
+        self, sim: Simulation, path: str | Path, names: list[RobotNames], *, namespace: str = "/",
+        topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim",
+    ) -> None:
+        """Open the bag and write the latched messages (/tf_static, and /map when ``with_map``).
+
+        ``topics`` restricts the recording to those names (relative ones resolved in ``namespace``).
+        Raises ValueError for an unknown topic and BagError when the file cannot be written."""
+        self._sim = sim
+        self._prog = prog
+        per_robot = robot_topics(names, namespace)
+        self.topics = select(stageros_topics(per_robot, with_map), topics, namespace)
+        self._wanted = {t.name for t in self.topics}
+        self._builder = MessageBuilder(sim, names, per_robot)
+        self._scan_wanted = {(i, k) for i, robot in enumerate(per_robot)
+                             for k, name in enumerate(robot.scans) if name in self._wanted}
+        self._per_step = sum(name in self._wanted for name in ("/clock", "/tf")) + sum(
+            (r.odom in self._wanted) + (r.ground_truth in self._wanted) + (r.stall in self._wanted) for r in per_robot)
+        self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY)
+        self.messages = self.dropped_steps = self.dropped_messages = 0
+        self.error: str | None = None
+        self._crash: BaseException | None = None
+        try:
+            grid = sim.static.to_occupancy_grid() if MAP in self._wanted else None
+            for topic, log_time, data in self._builder.static(sim.sim_time_us, grid):
+                if topic in self._wanted:
+                    self._bag.write(topic, log_time, data)
+                    self.messages += 1
+        except OSError as exc:
+            self._bag.abort()
+            raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
+        beams = sum(r.sensor.samples for robot in sim.robots for r in robot.rangers)
+        self._queue: queue.Queue[StepState | None] = queue.Queue(
+            maxsize=max(16, min(10_000, QUEUE_BYTES // (8 * beams + 64 * len(sim.robots) + 64))))
+        self._thread = threading.Thread(target=self._drain, name="bag-writer", daemon=True)
+        self._thread.start()
+
+    @property
+    def failed(self) -> bool:
+        """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded)."""
+        return self.error is not None
+
+    def record_step(self) -> None:
+        """Queue what the step just taken published; never blocks (a full queue drops the step)."""
+        if self.failed:
+            return
+        state = StepState.capture(self._sim)
+        try:
+            self._queue.put_nowait(state)
+        except queue.Full:
+            self.dropped_steps += 1
+            self.dropped_messages += self._per_step + sum((i, k) in self._scan_wanted for i, k, *_ in state.scans)
+
+    def close(self) -> BagSummary:
+        """Write what is queued, then the index: the file is complete. Safe to call once, also after errors."""
+        self._queue.put(None)
+        self._thread.join()
+        if self._crash is not None:
+            self._bag.abort()
+            raise self._crash
+        if self.error is None:
+            try:
+                self._bag.finish({"dropped_steps": str(self.dropped_steps),
+                                  "dropped_messages": str(self.dropped_messages)})
+            except OSError as exc:
+                self.error = exc.strerror or str(exc)
+        return BagSummary(self._bag.path, self.messages, self.dropped_steps, self.dropped_messages, self.error)
+
+    def _drain(self) -> None:
+        """The writer thread: build and write queued steps until the closing None."""
+        while (state := self._queue.get()) is not None:
+            if self.error is not None or self._crash is not None:
+                continue
+            try:
+                for topic, log_time, data in self._builder.step(state, self._wanted):
+                    self._bag.write(topic, log_time, data)
+                    self.messages += 1
+            except OSError as exc:
+                self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
+                self._bag.abort()
+                print(f"{self._prog}: cannot write bag {self._bag.path}: {self.error}; recording stopped (recover "
+                      f"what was written with: stage_sim recover {self._bag.path})", file=sys.stderr, flush=True)
+            except BaseException as exc:  # a bug: re-raised by close() on the caller's thread
+                self._crash = exc
