@@ -14,10 +14,12 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from stage_sim.cli import inspect, render, view
+from stage_sim.cli import inspect, recover, render, run, view
 from stage_sim.worldfile.errors import WorldError
 
-COMMANDS: list[Callable[[Any], None]] = [inspect.add_command, render.add_command, view.add_command]
+COMMANDS: list[Callable[[Any], None]] = [
+    inspect.add_command, render.add_command, view.add_command, run.add_command, recover.add_command,
+]
 """Each entry adds one subcommand and sets ``run``."""
 
 
