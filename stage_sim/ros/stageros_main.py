@@ -1,4 +1,5 @@
-"""``stageros [-g] [-u] [--view-*] [--speedup X] [--seed N] [--kernels K] [--threads N] WORLD [--ros-args ...]``.
+"""``stageros [-g] [-u] [--view-*] [--speedup X] [--seed N] [--kernels K] [--threads N]
+[--bag OUT.mcap] WORLD [--ros-args ...]``.
 
 Unless ``-g`` is given it serves the browser view (:mod:`stage_sim.ros.view`) and prints its URL. A broken
 world prints ``file:line:column: ...`` and exits with status 2 (no traceback); Ctrl-C and the world's
@@ -18,6 +19,8 @@ import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.utilities import remove_ros_args
 
+from stage_sim.bags.errors import BagError
+from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.sensing.kernels import add_kernel_arguments
@@ -38,6 +41,7 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--seed", type=int, default=None, help="seed for drawn odometry errors and sensor noise")
     add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
     add_record_arguments(parser)
+    add_bag_arguments(parser)
     parser.add_argument("world", nargs="?", default=None,
                         help="a .world file, or a bundled world's name (else the 'world_file' parameter)")
     return parser.parse_args(argv)
@@ -56,11 +60,11 @@ def main(argv: list[str] | None = None) -> int:
                         kernels=args.kernels, threads=args.threads)
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        with recording(node, args, "stageros"), viewing(node, args):
+        with recording(node, args, "stageros"), viewing(node, args), bag_recording(node, args, "stageros"):
             while rclpy.ok() and not node.finished:
                 executor.spin_once(timeout_sec=0.1)
         return 0
-    except (WorldError, FileNotFoundError, ValueError) as error:
+    except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"stageros: {error}", file=sys.stderr)
         return 2
     except (KeyboardInterrupt, ExternalShutdownException):
