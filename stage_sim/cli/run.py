@@ -3,7 +3,8 @@
 The bag holds what ``stageros --bag`` records for the same world, seed and commands (same topics, frames,
 types, QoS and field values) but comes from the core alone: no rclpy, no ROS install. The run ends at
 ``--duration`` sim seconds, at the world's ``quit_time`` or on Ctrl-C / SIGTERM; each finalises the bag.
-Exit status 0, 1 when the bag could not be written to the end, 2 for bad input.
+Exit status 0 (also after Ctrl-C during the run), 1 when the bag could not be written to the end, 2 for bad
+input, 130 for Ctrl-C before the first step.
 """
 
 from __future__ import annotations
@@ -20,15 +21,26 @@ from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
 
 
 def run(args: argparse.Namespace) -> int:
+    if (args.bag_topics or args.map) and not args.bag:
+        print("stage_sim run: --bag-topics and --map choose what --bag records; give --bag OUT.mcap", file=sys.stderr)
+        return 2
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        return _run(args)
+    except KeyboardInterrupt:  # before the first step: there is nothing to finalise
+        print("stage_sim run: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
     from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
-    if (args.bag_topics or args.map) and not args.bag:
-        print("stage_sim run: --bag-topics and --map choose what --bag records; give --bag OUT.mcap", file=sys.stderr)
-        return 2
     description = load_world(resolve_world(args.world))
     sim = Simulation(description, seed=args.seed)
     for warning in sim.warnings:
@@ -48,7 +60,6 @@ def run(args: argparse.Namespace) -> int:
     if description.settings.quit_time > 0:
         end = min(end, description.settings.quit_time)
     drive = CONTROLLERS[args.controller](sim, args.seed)
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
     start = time.monotonic()
     try:
         while sim.sim_time < end - 1e-9 and not (recorder and recorder.failed):
@@ -61,7 +72,6 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print(f"stage_sim run: interrupted at sim time {sim.sim_time:g} s", file=sys.stderr)
     finally:
-        signal.signal(signal.SIGTERM, previous)
         summary = recorder.close() if recorder else None
     wall = time.monotonic() - start
     print(f"{description.path.name}: {sim.sim_time:g} s of sim time in {wall:.1f} s of wall time "
