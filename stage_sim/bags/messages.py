@@ -12,7 +12,7 @@ description the ROS layer fills its rclpy messages from.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
@@ -84,26 +84,57 @@ def _transform(time: object, edge: fields.Edge) -> object:
                             rotation=_quaternion(edge.yaw)))
 
 
-def _odometry(time: object, frame: str, child: str, pose: np.ndarray, velocity: np.ndarray) -> object:
+def _odometry(frame: str, child: str) -> object:
+    """An Odometry between two frames, covariances 0 (as stageros sends them), filled by :func:`_fill_odometry`."""
     return Odometry(
-        header=Header(stamp=time, frame_id=frame), child_frame_id=child,
-        pose=PoseWithCovariance(
-            pose=Pose(position=Point(x=float(pose[0]), y=float(pose[1]), z=0.0), orientation=_quaternion(pose[2])),
-            covariance=_NO_COVARIANCE),
+        header=Header(stamp=_time(0), frame_id=frame), child_frame_id=child,
+        pose=PoseWithCovariance(pose=Pose(position=Point(x=0.0, y=0.0, z=0.0), orientation=_quaternion(0.0)),
+                                covariance=_NO_COVARIANCE),
         twist=TwistWithCovariance(
-            twist=Twist(linear=Vector3(x=float(velocity[0]), y=float(velocity[1]), z=0.0),
-                        angular=Vector3(x=0.0, y=0.0, z=float(velocity[2]))),
+            twist=Twist(linear=Vector3(x=0.0, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.0)),
             covariance=_NO_COVARIANCE))
+
+
+def _fill_odometry(msg: object, time: object, pose: np.ndarray, velocity: np.ndarray) -> object:
+    msg.header.stamp = time
+    position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
+    position.x, position.y = float(pose[0]), float(pose[1])
+    _, _, orientation.z, orientation.w = fields.yaw_quaternion(float(pose[2]))
+    twist = msg.twist.twist
+    twist.linear.x, twist.linear.y, twist.angular.z = float(velocity[0]), float(velocity[1]), float(velocity[2])
+    return msg
+
+
+@dataclass
+class _RobotMessages:
+    """The messages one robot publishes every step, allocated once and refilled (as the node does)."""
+
+    odom: object
+    truth: object
+    stall: object
+    odom_tf: object
+    scans: list[object]
 
 
 class MessageBuilder:
     """Turns a simulation's states into (topic, log time ns, CDR bytes) as stageros would publish them."""
 
     def __init__(self, sim: Simulation, names: list[RobotNames], topics: list[RobotTopics]) -> None:
-        self.names = names
         self.topics = topics
-        self.geometry = [[fields.scan_geometry(r) for r in robot.rangers] for robot in sim.robots]
         self.edges = fields.static_edges(sim.robots, names)
+        self._out = [
+            _RobotMessages(
+                odom=_odometry(n.odom_frame, n.base_footprint),
+                truth=_odometry(fields.WORLD_FRAME, n.base_footprint),
+                stall=Bool(data=False),
+                odom_tf=_transform(_time(0), fields.Edge(n.odom_frame, n.base_footprint, 0.0, 0.0, 0.0, 0.0)),
+                scans=[LaserScan(header=Header(stamp=_time(0), frame_id=frame), **asdict(fields.scan_geometry(r)),
+                                 ranges=np.zeros(0, np.float32), intensities=np.zeros(0, np.float32))
+                       for r, frame in zip(robot.rangers, n.laser_frames, strict=True)],
+            )
+            for robot, n in zip(sim.robots, names, strict=True)
+        ]
+        self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
 
     def static(self, sim_time_us: int, grid: OccupancyGrid | None) -> Iterator[tuple[str, int, bytes]]:
         """The latched messages stageros sends once at start: /tf_static, and /map when asked."""
@@ -112,11 +143,10 @@ class MessageBuilder:
         tf = TFMessage(transforms=[_transform(time, edge) for edge in self.edges])
         yield TF_STATIC, log_time, TYPESTORE.serialize_cdr(tf, TFMessage.__msgtype__)
         if grid is not None:
-            resolution = float(grid.resolution)
             origin = Pose(position=Point(x=float(grid.origin[0]), y=float(grid.origin[1]), z=0.0),
                           orientation=_quaternion(grid.origin[2]))
-            info = MapMetaData(map_load_time=time, resolution=resolution, width=grid.width, height=grid.height,
-                               origin=origin)
+            info = MapMetaData(map_load_time=time, resolution=float(grid.resolution), width=grid.width,
+                               height=grid.height, origin=origin)
             msg = OccupancyGridMsg(header=Header(stamp=time, frame_id=fields.WORLD_FRAME), info=info,
                                    data=grid.values.astype(np.int8).ravel())
             yield MAP, log_time, TYPESTORE.serialize_cdr(msg, OccupancyGridMsg.__msgtype__)
@@ -131,27 +161,25 @@ class MessageBuilder:
         scans: dict[int, list[tuple[int, np.ndarray, np.ndarray]]] = {}
         for robot, ranger, ranges, intensities in state.scans:
             scans.setdefault(robot, []).append((ranger, ranges, intensities))
-        for i, (names, topics) in enumerate(zip(self.names, self.topics, strict=True)):
+        for i, (out, topics) in enumerate(zip(self._out, self.topics, strict=True)):
             if topics.odom in wanted:
-                msg = _odometry(time, names.odom_frame, names.base_footprint, state.odometry[i], state.velocities[i])
+                msg = _fill_odometry(out.odom, time, state.odometry[i], state.velocities[i])
                 yield topics.odom, log_time, serialize(msg, Odometry.__msgtype__)
             if topics.ground_truth in wanted:
-                msg = _odometry(time, fields.WORLD_FRAME, names.base_footprint, state.truth[i],
-                                state.truth_velocities[i])
+                msg = _fill_odometry(out.truth, time, state.truth[i], state.truth_velocities[i])
                 yield topics.ground_truth, log_time, serialize(msg, Odometry.__msgtype__)
             if topics.stall in wanted:
-                yield topics.stall, log_time, serialize(Bool(data=bool(state.stalled[i])), Bool.__msgtype__)
+                out.stall.data = bool(state.stalled[i])
+                yield topics.stall, log_time, serialize(out.stall, Bool.__msgtype__)
             for ranger, ranges, intensities in scans.get(i, ()):
                 if topics.scans[ranger] in wanted:
-                    g = self.geometry[i][ranger]
-                    msg = LaserScan(
-                        header=Header(stamp=time, frame_id=names.laser_frames[ranger]), angle_min=g.angle_min,
-                        angle_max=g.angle_max, angle_increment=g.angle_increment, time_increment=g.time_increment,
-                        scan_time=g.scan_time, range_min=g.range_min, range_max=g.range_max, ranges=ranges,
-                        intensities=intensities)
+                    msg = out.scans[ranger]
+                    msg.header.stamp, msg.ranges, msg.intensities = time, ranges, intensities
                     yield topics.scans[ranger], log_time, serialize(msg, LaserScan.__msgtype__)
         if TF in wanted:
-            tf = TFMessage(transforms=[
-                _transform(time, fields.Edge(names.odom_frame, names.base_footprint, pose[0], pose[1], 0.0, pose[2]))
-                for names, pose in zip(self.names, state.odometry, strict=True)])
-            yield TF, log_time, serialize(tf, TFMessage.__msgtype__)
+            for out, pose in zip(self._out, state.odometry, strict=True):
+                transform = out.odom_tf.transform
+                out.odom_tf.header.stamp = time
+                transform.translation.x, transform.translation.y = float(pose[0]), float(pose[1])
+                _, _, transform.rotation.z, transform.rotation.w = fields.yaw_quaternion(float(pose[2]))
+            yield TF, log_time, serialize(self._tf, TFMessage.__msgtype__)

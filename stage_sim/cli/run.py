@@ -74,7 +74,7 @@ def _run(args: argparse.Namespace) -> int:
     finally:
         summary = recorder.close() if recorder else None
     wall = time.monotonic() - start
-    print(f"{description.path.name}: {sim.sim_time:g} s of sim time in {wall:.1f} s of wall time "
+    print(f"{description.path.name}: {sim.sim_time:g} s of sim time in {wall:.2f} s of wall time "
           f"({sim.sim_time / wall if wall > 0 else float('inf'):.1f}x real time)")
     if summary:
         print(summary.describe(), file=sys.stderr if summary.error or summary.dropped_steps else sys.stdout)

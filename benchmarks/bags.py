@@ -1,0 +1,88 @@
+"""What recording a bag costs: ``stage_sim run ... --speedup 0`` with and without ``--bag``, and scans recorded
+per wall second for 1 and 100 robots.
+
+Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 600] [--robots 1 100]``. Each
+case runs the console script in its own process (as users run it) and reads the sim and wall time it prints;
+one JSON object per line:
+
+- ``overhead``: rooms.world for ``--duration`` sim seconds, plain and with ``--bag``: sim seconds per wall
+  second of each and ``cost_pct``, how much slower the recording run is (the issue's target: <= 15).
+- ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
+  LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from mcap.reader import make_reader
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+from simulate import world_text  # noqa: E402 - the benchmark worlds of N robots, shared with simulate.py
+
+STAGE_SIM = Path(sys.executable).with_name("stage_sim")
+RATE = re.compile(r": ([\d.]+) s of sim time in ([\d.]+) s of wall time")
+
+
+def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict:
+    """One ``stage_sim run``: sim and wall seconds it reports, and what the bag holds."""
+    command = [str(STAGE_SIM), "run", str(world), "--duration", str(duration), "--speedup", "0",
+               "--controller", controller, "--seed", "1"]
+    if bag is not None:
+        command += ["--bag", str(bag)]
+    result = subprocess.run(command, capture_output=True, text=True, check=True)
+    sim_s, wall_s = map(float, RATE.search(result.stdout).groups())
+    out = {"sim_s": sim_s, "wall_s": wall_s, "sim_rate": round(sim_s / wall_s, 2)}
+    if bag is not None:
+        with bag.open("rb") as stream:
+            reader = make_reader(stream)
+            summary = reader.get_summary()
+            dropped = next(m.metadata for m in reader.iter_metadata() if m.name == "stage_sim")
+        counts = summary.statistics.channel_message_counts
+        out["scans"] = sum(counts.get(i, 0) for i, c in summary.channels.items()
+                           if summary.schemas[c.schema_id].name == "sensor_msgs/msg/LaserScan")
+        out["bag_mb"] = round(bag.stat().st_size / 2**20, 2)
+        out["dropped_steps"] = int(dropped["dropped_steps"])
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=600.0, help="sim seconds of the overhead runs")
+    parser.add_argument("--controller", default="straight", choices=["straight", "wander"])
+    parser.add_argument("--robots", type=int, nargs="+", default=[1, 100])
+    parser.add_argument("--throughput-duration", type=float, default=None,
+                        help="sim seconds of each throughput run (default: 600 for one robot, 30 for more)")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
+        rooms = REPO / "worlds" / "rooms.world"
+        plain = run(rooms, args.duration, args.controller, None)
+        recorded = run(rooms, args.duration, args.controller, tmp / "rooms.mcap")
+        print(json.dumps({
+            "case": "overhead", "world": "rooms.world", "controller": args.controller, "duration": args.duration,
+            "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
+            "cost_pct": round(100 * (1 - recorded["sim_rate"] / plain["sim_rate"]), 1),
+            "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}), flush=True)
+        for robots in args.robots:
+            world = tmp / f"robots_{robots}.world"
+            world.write_text(world_text(robots, 240, seed=1))
+            duration = args.throughput_duration or (600.0 if robots == 1 else 30.0)
+            result = run(world, duration, "straight", tmp / f"robots_{robots}.mcap")
+            print(json.dumps({
+                "case": "throughput", "robots": robots, "beams": 240, "duration": duration,
+                "scans": result["scans"], "wall_s": result["wall_s"],
+                "scans_per_wall_s": round(result["scans"] / result["wall_s"], 1), "sim_rate": result["sim_rate"],
+                "bag_mb": result["bag_mb"], "dropped_steps": result["dropped_steps"]}), flush=True)
+
+
+if __name__ == "__main__":
+    main()
