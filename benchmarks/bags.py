@@ -5,8 +5,10 @@ Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 60
 case runs the console script in its own process (as users run it) and reads the sim and wall time it prints;
 one JSON object per line:
 
-- ``overhead``: rooms.world for ``--duration`` sim seconds, plain and with ``--bag``: sim seconds per wall
-  second of each and ``cost_pct``, how much slower the recording run is (the issue's target: <= 15).
+- ``overhead``: rooms.world for ``--duration`` sim seconds, plain and with ``--bag``, ``--repeat`` times each
+  (interleaved; the best counts, as the machine is shared): sim seconds per wall second of each and
+  ``cost_pct``, how much slower the recording run is (the issue's target: <= 15); ``cpu_cost_pct``, the
+  same from the processes' CPU seconds (both threads), which the load of other processes disturbs less.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
   LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
 """
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -38,9 +41,12 @@ def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict
                "--controller", controller, "--seed", "1"]
     if bag is not None:
         command += ["--bag", str(bag)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     result = subprocess.run(command, capture_output=True, text=True, check=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     sim_s, wall_s = map(float, RATE.search(result.stdout).groups())
-    out = {"sim_s": sim_s, "wall_s": wall_s, "sim_rate": round(sim_s / wall_s, 2)}
+    cpu_s = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    out = {"sim_s": sim_s, "wall_s": wall_s, "sim_rate": round(sim_s / wall_s, 2), "cpu_s": cpu_s}
     if bag is not None:
         with bag.open("rb") as stream:
             reader = make_reader(stream)
@@ -58,6 +64,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=600.0, help="sim seconds of the overhead runs")
     parser.add_argument("--controller", default="straight", choices=["straight", "wander"])
+    parser.add_argument("--repeat", type=int, default=3, help="overhead runs of each kind (best one counts)")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 100])
     parser.add_argument("--throughput-duration", type=float, default=None,
                         help="sim seconds of each throughput run (default: 600 for one robot, 30 for more)")
@@ -65,12 +72,18 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         tmp = Path(folder)
         rooms = REPO / "worlds" / "rooms.world"
-        plain = run(rooms, args.duration, args.controller, None)
-        recorded = run(rooms, args.duration, args.controller, tmp / "rooms.mcap")
+        plains, bags = [], []
+        for _ in range(args.repeat):  # interleaved, best of each: the machine is shared and its load varies
+            plains.append(run(rooms, args.duration, args.controller, None))
+            bags.append(run(rooms, args.duration, args.controller, tmp / "rooms.mcap"))
+        plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
+        cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
         print(json.dumps({
             "case": "overhead", "world": "rooms.world", "controller": args.controller, "duration": args.duration,
-            "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
+            "repeat": args.repeat, "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
             "cost_pct": round(100 * (1 - recorded["sim_rate"] / plain["sim_rate"]), 1),
+            "cpu_s_plain": round(cpu_plain, 2), "cpu_s_bag": round(cpu_bag, 2),
+            "cpu_cost_pct": round(100 * (cpu_bag / cpu_plain - 1), 1),
             "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}), flush=True)
         for robots in args.robots:
             world = tmp / f"robots_{robots}.world"

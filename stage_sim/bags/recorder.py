@@ -22,6 +22,10 @@ from stage_sim.bags.names import RobotNames
 from stage_sim.bags.topics import MAP, robot_topics, select, stageros_topics
 from stage_sim.sim.simulation import Simulation
 
+BATCH_STEPS = 64
+"""The writer thread is woken once per this many queued steps (or every WAKE_S): each wake-up costs the stepping
+thread a hand-over of the GIL, so waking per step would cost more than the writing itself."""
+WAKE_S = 0.1
 QUEUE_BYTES = 64 * 1024 * 1024
 """Memory the queue of pending steps may hold (ranges and intensities dominate: 8 bytes per beam)."""
 LIBRARY = "stage_sim bags (mcap + rosbags)"
@@ -85,6 +89,7 @@ class BagRecorder:
         beams = sum(r.sensor.samples for robot in sim.robots for r in robot.rangers)
         self._queue: queue.Queue[StepState | None] = queue.Queue(
             maxsize=max(16, min(10_000, QUEUE_BYTES // (8 * beams + 64 * len(sim.robots) + 64))))
+        self._wake = threading.Event()
         self._thread = threading.Thread(target=self._drain, name="bag-writer", daemon=True)
         self._thread.start()
 
@@ -100,6 +105,8 @@ class BagRecorder:
         state = StepState.capture(self._sim)
         try:
             self._queue.put_nowait(state)
+            if self._queue.qsize() >= BATCH_STEPS:
+                self._wake.set()
         except queue.Full:
             self.dropped_steps += 1
             self.dropped_messages += self._per_step + sum((i, k) in self._scan_wanted for i, k, *_ in state.scans)
@@ -107,6 +114,7 @@ class BagRecorder:
     def close(self) -> BagSummary:
         """Write what is queued, then the index: the file is complete. Safe to call once, also after errors."""
         self._queue.put(None)
+        self._wake.set()
         self._thread.join()
         if self._crash is not None:
             self._bag.abort()
@@ -120,10 +128,22 @@ class BagRecorder:
         return BagSummary(self._bag.path, self.messages, self.dropped_steps, self.dropped_messages, self.error)
 
     def _drain(self) -> None:
-        """The writer thread: build and write queued steps until the closing None."""
-        while (state := self._queue.get()) is not None:
-            if self.error is not None or self._crash is not None:
-                continue
+        """The writer thread: build and write queued steps, a batch per wake-up, until the closing None."""
+        while True:
+            self._wake.wait(WAKE_S)
+            self._wake.clear()
+            while True:
+                try:
+                    state = self._queue.get_nowait()
+                except queue.Empty:
+                    break
+                if state is None:
+                    return
+                self._write(state)
+
+    def _write(self, state: StepState) -> None:
+        """One step's messages into the bag; a write error stops the recording, a bug is kept for close()."""
+        if self.error is None and self._crash is None:
             try:
                 for topic, log_time, data in self._builder.step(state, self._wanted):
                     self._bag.write(topic, log_time, data)
