@@ -23,8 +23,8 @@ from stage_sim.bags.topics import MAP, robot_topics, select, stageros_topics
 from stage_sim.sim.simulation import Simulation
 
 BATCH_STEPS = 64
-"""The writer thread is woken once per this many queued steps (or every WAKE_S): each wake-up costs the stepping
-thread a hand-over of the GIL, so waking per step would cost more than the writing itself."""
+"""The writer thread is woken once per this many queued steps (at most half the queue; or every WAKE_S): each
+wake-up costs the stepping thread a hand-over of the GIL, so waking per step would cost more than the writing."""
 WAKE_S = 0.1
 QUEUE_BYTES = 64 * 1024 * 1024
 """Memory the queue of pending steps may hold (ranges and intensities dominate: 8 bytes per beam)."""
@@ -89,6 +89,7 @@ class BagRecorder:
         beams = sum(r.sensor.samples for robot in sim.robots for r in robot.rangers)
         self._queue: queue.Queue[StepState | None] = queue.Queue(
             maxsize=max(16, min(10_000, QUEUE_BYTES // (8 * beams + 64 * len(sim.robots) + 64))))
+        self._batch = min(BATCH_STEPS, self._queue.maxsize // 2)
         self._wake = threading.Event()
         self._thread = threading.Thread(target=self._drain, name="bag-writer", daemon=True)
         self._thread.start()
@@ -105,7 +106,7 @@ class BagRecorder:
         state = StepState.capture(self._sim)
         try:
             self._queue.put_nowait(state)
-            if self._queue.qsize() >= BATCH_STEPS:
+            if self._queue.qsize() >= self._batch:
                 self._wake.set()
         except queue.Full:
             self.dropped_steps += 1

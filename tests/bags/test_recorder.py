@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from mcap.reader import make_reader
 
 from stage_sim.bags.errors import BagError
 from stage_sim.bags.names import robot_names
@@ -174,3 +176,33 @@ def test_unknown_topic_and_unwritable_path_are_errors_before_any_step(tmp_path) 
         BagRecorder(sim, tmp_path / "missing" / "x.mcap", names_of(sim))
     with pytest.raises(BagError, match=r"must end in \.mcap"):
         BagRecorder(sim, tmp_path / "x.bag", names_of(sim))
+
+
+def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp_path, monkeypatch) -> None:
+    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
+    path = tmp_path / "slow.mcap"
+    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)  # the smallest queue: 16 steps
+    recorder = BagRecorder(sim, path, names_of(sim))
+    write = recorder._bag.write
+
+    def slow_write(*args) -> None:  # a disk that takes 2 ms per message: 24 ms per step of this world
+        time.sleep(0.002)
+        write(*args)
+
+    monkeypatch.setattr(recorder._bag, "write", slow_write)
+    longest = 0.0
+    for _ in range(150):
+        sim.step()
+        start = time.perf_counter()
+        recorder.record_step()
+        longest = max(longest, time.perf_counter() - start)
+    summary = recorder.close()
+    assert summary.dropped_steps > 0 and longest < 0.05
+    assert summary.messages + summary.dropped_messages == 1 + 150 * 12
+    assert f"dropped {summary.dropped_messages} messages of {summary.dropped_steps} steps" in summary.describe()
+    bag = READERS["mcap"](path)
+    assert bag.counts()["/clock"] == 150 - summary.dropped_steps
+    with path.open("rb") as stream:
+        (record,) = [m for m in make_reader(stream).iter_metadata() if m.name == "stage_sim"]
+    assert record.metadata == {"dropped_steps": str(summary.dropped_steps),
+                               "dropped_messages": str(summary.dropped_messages)}
