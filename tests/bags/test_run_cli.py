@@ -19,6 +19,8 @@ from stage_sim.worldfile.loader import load_world
 from tests.bags.readers import READERS
 from tests.bags.worlds import ROBOT_TOPICS, two_robot_world
 
+pytestmark = pytest.mark.slow  # every test starts the console script
+
 ROS_PACKAGES = ("rclpy", "builtin_interfaces", "geometry_msgs", "nav_msgs", "rosgraph_msgs", "sensor_msgs",
                 "std_msgs", "tf2_msgs")
 # Runs the console script's main() and fails (status 3) if anything of ROS was imported on the way.

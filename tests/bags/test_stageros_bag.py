@@ -10,6 +10,7 @@ import sys
 from collections import defaultdict
 from pathlib import Path
 
+import pytest
 from mcap.reader import make_reader
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -80,6 +81,7 @@ def test_the_bag_names_the_types_with_ros_own_hashes(tmp_path) -> None:
         assert channel.metadata["topic_type_hash"] == ros_hash, msgtype
 
 
+@pytest.mark.slow
 def test_stageros_finalises_the_bag_at_quit_time(tmp_path) -> None:
     bag_path = tmp_path / "quit.mcap"
     result = subprocess.run(
@@ -91,6 +93,7 @@ def test_stageros_finalises_the_bag_at_quit_time(tmp_path) -> None:
     assert READERS["rosbags"](bag_path).counts() == {"/clock": 10, "/robot_1/base_scan_1": 10}
 
 
+@pytest.mark.slow
 def test_stageros_refuses_a_bag_it_cannot_write(tmp_path) -> None:
     result = subprocess.run(
         [str(Path(sys.executable).with_name("stageros")), str(two_robot_world(tmp_path)), "--bag",
