@@ -85,7 +85,7 @@ def test_the_bag_names_the_types_with_ros_own_hashes(tmp_path) -> None:
 def test_stageros_finalises_the_bag_at_quit_time(tmp_path) -> None:
     bag_path = tmp_path / "quit.mcap"
     result = subprocess.run(
-        [str(Path(sys.executable).with_name("stageros")), str(two_robot_world(tmp_path, quit_time=1.0)),
+        [str(Path(sys.executable).with_name("stageros")), "-g", str(two_robot_world(tmp_path, quit_time=1.0)),
          "--speedup", "0", "--bag", str(bag_path), "--bag-topics", "/clock", "robot_1/base_scan_1"],
         capture_output=True, text=True, timeout=120, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
@@ -96,7 +96,7 @@ def test_stageros_finalises_the_bag_at_quit_time(tmp_path) -> None:
 @pytest.mark.slow
 def test_stageros_refuses_a_bag_it_cannot_write(tmp_path) -> None:
     result = subprocess.run(
-        [str(Path(sys.executable).with_name("stageros")), str(two_robot_world(tmp_path)), "--bag",
+        [str(Path(sys.executable).with_name("stageros")), "-g", str(two_robot_world(tmp_path)), "--bag",
          str(tmp_path / "missing" / "x.mcap")], capture_output=True, text=True, timeout=120, env=dict(os.environ))
     assert result.returncode == 2
     assert "stageros: cannot write bag" in result.stderr and "Traceback" not in result.stderr
