@@ -3,7 +3,8 @@
 Dependencies point one way only, top to bottom (enforced by import-linter, ``.importlinter``)::
 
     cli | ros                                   entry points; only ros imports rclpy
-    runs | rendering                            uses of a running simulation
+    envs                                        Gymnasium / PettingZoo environments
+    runs | rendering | view | bags              uses of a running simulation
     wander                                      the reactive controller (never imports sim)
     sim                                         Simulation: robots, kinematics, odometry, collision
     sensing                                     exact ray casting on the grid
