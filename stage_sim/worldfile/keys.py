@@ -240,6 +240,19 @@ class Properties:
         x, y, z, a = self.numbers(key, 4, [length, length, length, angle]) or (0.0, 0.0, 0.0, 0.0)
         return Pose(x, y, z, a)
 
+    def size(self, default_height: float) -> tuple[float, float, float] | None:
+        """``size [x y z]`` in metres; a Stage 3 ``[x y]`` gets ``default_height`` (Stage 4 refuses it)."""
+        prop = self.take("size")
+        if prop is not None and len(prop.values) == 2:
+            self.warnings.add(
+                f"Stage 3 size [x y] read as [x y {default_height:g}] (Stage 4 refuses fewer than 3 values)",
+                prop.location,
+            )
+            x, y = self.lengths("size", 2) or (0.0, 0.0)
+            return (x, y, default_height)
+        found = self.lengths("size", 3)
+        return None if found is None else (found[0], found[1], found[2])
+
     def color(self, default: RGBA) -> RGBA:
         """``color "X11 name"``, overridden by ``color_rgba [r g b a]`` as in Stage; unknown names warn."""
         result = default

@@ -16,16 +16,15 @@ inside a ranger, ``laser_return``, ``interval_real`` ...) stay ignored, with a w
 from __future__ import annotations
 
 import math
-import os
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from stage_sim.worldfile.bitmap_files import BitmapFiles
 from stage_sim.worldfile.colors import RGBA
 from stage_sim.worldfile.description import (
-    Bitmap,
     Block,
     Model,
     Pose,
@@ -60,9 +59,11 @@ from stage_sim.worldfile.syntax import (
 
 MODEL_TYPES = frozenset(
     {"model", "position", "ranger", "camera", "fiducial", "blobfinder", "gripper", "actuator", "bumper",
-     "blinkenlight", "lightindicator"}
+     "blinkenlight", "lightindicator", "wifi"}
 )  # fmt: skip
+"""Stage 4's model types, and Stage 3's ``wifi`` (its wifi worlds are still in Stage's tree)."""
 NOT_SIMULATED = MODEL_TYPES - {"model", "position", "ranger"}
+"""Read (bodies, names, poses) and ignored with one warning per type and world; they produce no data."""
 BODY_TYPES = frozenset({"model", "position"})
 """Types that get Stage's default unit-square body when they have neither ``block`` nor ``bitmap``."""
 BUILTIN_TYPES = MODEL_TYPES | {"window", "block", "sensor", "laser"}
@@ -104,9 +105,11 @@ class _Loader:
         self.warnings = Warnings()
         self.units = Units()
         self.macros: dict[str, Define] = {}
-        self.bitmaps: dict[Path, Bitmap] = {}
+        self.bitmaps = BitmapFiles(syntax.path)
         self.names: set[str] = set()
         self.model_count = 0
+        self.not_simulated: dict[str, list[SourceLocation]] = {}
+        """Where each model of a type this simulator ignores was read, to warn once per type."""
 
     def load(self) -> WorldDescription:
         world = Properties(self.syntax.properties, self.units, self.warnings)
@@ -139,6 +142,9 @@ class _Loader:
             else:
                 models.append(self._model(instance, None, counters, 0))
         settings = self._settings(world, window)
+        for kind, locations in self.not_simulated.items():
+            more = f"; {len(locations)} in this world, the first here" if len(locations) > 1 else ""
+            self.warnings.add(f"'{kind}' models are not simulated (loaded, but produce no data){more}", locations[0])
         return WorldDescription(self.syntax.path, settings, models, self.warnings.items)
 
     def _settings(self, world: Properties, window: WindowSettings | None) -> WorldSettings:
@@ -223,7 +229,7 @@ class _Loader:
         if kind in BODY_TYPES and not model.blocks and model.bitmap is None:
             model.blocks.append(Block(_UNIT_SQUARE.copy(), (0.0, 1.0), None))
         if kind in NOT_SIMULATED:
-            self.warnings.add(f"'{kind}' models are not simulated (loaded, but produce no data)", instance.location)
+            self.not_simulated.setdefault(kind, []).append(instance.location)
         else:
             props.report_unread(f"a {kind} model", MODEL_IGNORED)
         return model
@@ -231,10 +237,11 @@ class _Loader:
     def _model_keys(self, model: Model, props: Properties, top_level: bool) -> None:
         """The keys every model type has (spec §8.5)."""
         model.pose = props.pose("pose", Pose()) or Pose()
-        size = props.lengths("size", 3)
+        default_size = _DEFAULT_SIZES.get(model.type, (0.4, 0.4, 1.0))
+        size = props.size(default_size[2])
         if size is not None:
             props.require(min(size) >= 0, "size", list(size), "sizes >= 0")
-        model.size = (size[0], size[1], size[2]) if size else _DEFAULT_SIZES.get(model.type, (0.4, 0.4, 1.0))
+        model.size = size or default_size
         model.origin = props.pose("origin", Pose()) or Pose()
         model.color = props.color(_DEFAULT_COLORS.get(model.type, (1.0, 0.0, 0.0, 1.0)))
         model.boundary = props.flag("boundary", False)
@@ -254,7 +261,7 @@ class _Loader:
                 self.warnings.add(f"'{key}' is not supported and ignored: {why}", prop.location)
         bitmap = props.take("bitmap")
         if bitmap is not None:
-            model.bitmap = self._bitmap(bitmap, props.string("bitmap", ""))
+            model.bitmap = self.bitmaps.load(bitmap, props.string("bitmap", ""))
             self._warn_if_trimmed(model)
 
     def _children(self, model: Model, instance: _Instance, depth: int) -> list[Sensor]:
@@ -321,32 +328,6 @@ class _Loader:
                 props.take(prop.name)
         props.report_unread("a block")
         return Block(np.array(points, dtype=float), (z[0], z[1]), instance.location)
-
-    def _bitmap(self, prop: Property, name: str) -> Bitmap:
-        """Load a ``bitmap`` relative to the world file: map_server YAML or a Stage image."""
-        path = Path(name)
-        if not path.is_absolute():
-            path = Path(os.path.normpath(self.syntax.path.parent / path))
-        if path in self.bitmaps:
-            return self.bitmaps[path]
-        if not path.is_file():
-            raise WorldError(
-                f"bitmap file not found: {path}",
-                prop.location,
-                found=f'"{name}"',
-                expected="an image or .yaml map, relative to the world file",
-            )
-        if path.suffix.lower() in (".yaml", ".yml"):
-            from stage_sim.worldfile.map_yaml import load_map_yaml
-
-            grid = load_map_yaml(path, requested_at=prop.location)
-            bitmap = Bitmap(path, np.ascontiguousarray(grid.occupied[::-1]), grid, prop.location)
-        else:
-            from stage_sim.worldfile.bitmap import load_stage_bitmap
-
-            bitmap = Bitmap(path, load_stage_bitmap(path, requested_at=prop.location), None, prop.location)
-        self.bitmaps[path] = bitmap
-        return bitmap
 
     def _warn_if_trimmed(self, model: Model) -> None:
         """Stage stretches only the occupied pixels' bounding box to ``size``: say so when margins are cut."""

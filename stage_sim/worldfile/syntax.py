@@ -9,6 +9,8 @@ Grammar (spec §8.2)::
     define   := 'define' NEWNAME PARENTNAME '(' { property | entity } ')'
     include  := 'include' STRING                 rest of the line discarded; top level only
 
+An include is found as :mod:`stage_sim.worldfile.search_path` says: Stage's place (beside the top-level
+world file, also for includes inside includes) first.
 Nothing here knows what a key means; :mod:`stage_sim.worldfile.loader` gives the tree its meaning.
 """
 
@@ -21,6 +23,7 @@ from pathlib import Path
 
 from stage_sim.worldfile.errors import SourceLocation, WorldError
 from stage_sim.worldfile.lexer import Token, TokenKind, tokenize
+from stage_sim.worldfile.search_path import SEARCH_ORDER, candidate_paths, describe_tried
 
 MAX_NESTING = 100
 """Entities nested deeper than this are refused (no real world comes close; it keeps recursion bounded)."""
@@ -244,11 +247,8 @@ class _FileParser:
         _FileParser(self.syntax, self.reader, [*self.chain, path]).parse(text, path)
 
     def _read_include(self, name: str, including: Path, where: SourceLocation) -> tuple[Path, str]:
-        """Open an include relative to the including file, then by base name in STAGEPATH (as Stage does)."""
-        given = Path(name)
-        candidates = [given if given.is_absolute() else Path(os.path.normpath(including.parent / given))]
-        for folder in filter(None, os.environ.get("STAGEPATH", "").split(os.pathsep)):
-            candidates.append(Path(folder) / given.name)
+        """Open the first of :func:`candidate_paths` that reads (Stage's rule first); name them all if none does."""
+        candidates = candidate_paths(name, self.syntax.path, including)
         problem = ""
         for candidate in candidates:
             if any(_same_file(candidate, seen) for seen in self.chain):
@@ -260,8 +260,12 @@ class _FileParser:
                 return candidate, self.reader(candidate)
             except OSError as exc:
                 problem = problem or (exc.strerror or str(exc))
-        tried = ", ".join(str(c) for c in candidates)
-        raise WorldError(f"cannot open include file {tried}", where, found=problem, expected="a readable file")
+        raise WorldError(
+            f'cannot open include file "{name}"; tried {describe_tried(candidates)}',
+            where,
+            found=problem,
+            expected=f"a readable file ({SEARCH_ORDER})",
+        )
 
 
 def _value(token: Token) -> Value:

@@ -68,11 +68,11 @@ def test_text_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
 
 def test_world_error_exits_2_with_location_on_stderr(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     world = tmp_path / "bad.world"
-    world.write_text("model(\n  size [1 2]\n)\n")
+    world.write_text("model(\n  size [1]\n)\n")
     assert cli.main(["inspect", str(world)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err.startswith(f"{world}:2:3: 'size' has too few values (found 2 values, expected 3 values)")
+    assert captured.err.startswith(f"{world}:2:3: 'size' has too few values (found 1 values, expected 3 values)")
 
 
 def test_unknown_world_name_exits_2(capsys: pytest.CaptureFixture[str]) -> None:

@@ -130,7 +130,7 @@ def test_include_cycle_names_the_chain() -> None:
 
 
 def test_error_inside_an_include_points_into_the_include() -> None:
-    error = error_of('include "r.inc"\nr( )\n', {"/virtual/r.inc": "define r position (\n  size [1 1]\n)\n"})
+    error = error_of('include "r.inc"\nr( )\n', {"/virtual/r.inc": "define r position (\n  size [1]\n)\n"})
     assert error.location == at(2, 3, "/virtual/r.inc")
 
 
@@ -185,9 +185,9 @@ def test_entity_inside_a_sensor() -> None:
 
 
 def test_too_few_tuple_values() -> None:
-    error = error_of("model(\n  size [0.01 0.04]\n)")
+    error = error_of("model(\n  size [0.01]\n)")
     assert error.location == at(2, 3)
-    assert "found 2 values, expected 3 values" in str(error)
+    assert "found 1 values, expected 3 values" in str(error)
 
 
 def test_empty_scalar_tuple() -> None:

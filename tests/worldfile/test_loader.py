@@ -658,7 +658,8 @@ def test_three_element_pose_reads_as_x_y_0_a() -> None:
 
 
 @pytest.mark.parametrize(
-    "kind", ["camera", "fiducial", "blobfinder", "gripper", "actuator", "bumper", "blinkenlight", "lightindicator"]
+    "kind",
+    ["camera", "fiducial", "blobfinder", "gripper", "actuator", "bumper", "blinkenlight", "lightindicator", "wifi"],
 )
 def test_unsupported_types_load_with_a_not_simulated_warning(kind: str) -> None:
     world = load(f"position( {kind}( range [0 5] fov 60 ) )")
@@ -666,6 +667,27 @@ def test_unsupported_types_load_with_a_not_simulated_warning(kind: str) -> None:
     assert child.type == kind
     assert messages(world) == [f"'{kind}' models are not simulated (loaded, but produce no data)"]
     assert world.warnings[0].location == SourceLocation("/virtual/w.world", 1, 11)
+
+
+def test_each_unsupported_type_warns_once_per_world_naming_the_count() -> None:
+    world = load(
+        "define bot position ( fiducial( ) camera( ) )\n"
+        + "bot( )\n" * 3
+        + 'wifi( ip "10.0.0.1" mac "00:03" essid "net" model "simple" range 4 )\n'
+    )
+    assert messages(world) == [
+        "'fiducial' models are not simulated (loaded, but produce no data); 3 in this world, the first here",
+        "'camera' models are not simulated (loaded, but produce no data); 3 in this world, the first here",
+        "'wifi' models are not simulated (loaded, but produce no data)",
+    ]
+    assert [w.location.column for w in world.warnings] == [23, 35, 1]
+    assert sum(m.type == "fiducial" for m in world.walk()) == 3
+
+
+def test_stage3_two_value_size_gets_the_default_height_with_a_warning() -> None:
+    world = load("model( size [2 3] )\nranger( size [0.1 0.2] )")
+    assert world.models[0].size == (2, 3, 1.0) and world.models[1].size == (0.1, 0.2, 0.2)
+    assert messages(world)[0] == "Stage 3 size [x y] read as [x y 1] (Stage 4 refuses fewer than 3 values)"
 
 
 def test_unknown_keys_warn_with_their_location() -> None:
