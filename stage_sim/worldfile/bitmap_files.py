@@ -35,8 +35,8 @@ class BitmapFiles:
             raise WorldError(
                 f'bitmap file not found: "{name}"; tried {describe_tried(candidates)}',
                 prop.location,
-                found=f'"{name}"',
-                expected=f"an image or .yaml map ({SEARCH_ORDER})",
+                found="no such file",
+                expected=f"an image or .yaml map; {SEARCH_ORDER}",
             )
         if path not in self._loaded:
             self._loaded[path] = self._read(path, prop)

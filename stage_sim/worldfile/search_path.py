@@ -14,8 +14,8 @@ import os
 from pathlib import Path
 
 STAGEPATH = "STAGEPATH"
-SEARCH_ORDER = ("relative names are looked for beside the world file (Stage's rule), then beside the file "
-                "naming them, then in the current directory and STAGEPATH")
+SEARCH_ORDER = ("a relative name is looked for beside the world file as in Stage, then beside the file that "
+                "names it, then in the current directory and STAGEPATH")
 
 
 def candidate_paths(name: str, world_file: Path, written_in: Path) -> list[Path]:

@@ -264,7 +264,7 @@ class _FileParser:
             f'cannot open include file "{name}"; tried {describe_tried(candidates)}',
             where,
             found=problem,
-            expected=f"a readable file ({SEARCH_ORDER})",
+            expected=f"a readable file; {SEARCH_ORDER}",
         )
 
 

@@ -1,0 +1,49 @@
+"""Real Stage worlds load and step, or stop with exit status 2 and a file:line:col: message.
+
+Every world runs in a child process with capped memory (tests/corpus/children.py); ``stage_sim inspect``
+must finish within 10 s of CPU time.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tests.corpus.children import CPU_BUDGET_S, LOCATED_MESSAGE, python_command, run_limited
+from tests.corpus.worlds_list import FAILS_TO_LOAD, OWN_WORLDS, World, params, require_corpus
+
+DRIVER = str(OWN_WORLDS.parent / "drive_world.py")
+
+
+def test_the_corpus_is_there() -> None:
+    require_corpus()
+
+
+@pytest.mark.parametrize("world", params())
+def test_inspect_loads_or_stops_with_a_located_message(world: World) -> None:
+    run = run_limited(python_command("-m", "stage_sim.cli", "inspect", "--json", str(world.path)))
+    assert run.returncode is not None, f"inspect still running after its wall timeout: {run.stderr[-500:]}"
+    assert "Traceback" not in run.stderr, run.stderr[-2000:]
+    if world.id in FAILS_TO_LOAD:
+        assert run.returncode == 2
+        assert run.stdout == ""
+        located = LOCATED_MESSAGE.match(run.stderr)
+        assert located is not None and located.group("file").endswith((".world", ".inc")), run.stderr
+        assert FAILS_TO_LOAD[world.id] in run.stderr.splitlines()[0]
+    else:
+        assert run.returncode == 0, run.stderr[-2000:]
+        report = json.loads(run.stdout)
+        assert report["world"]["path"] == str(world.path)
+    assert run.cpu_seconds < CPU_BUDGET_S
+
+
+@pytest.mark.parametrize("world", params(loading_only=True))
+def test_every_robot_drives_for_ten_steps(world: World) -> None:
+    run = run_limited(python_command(DRIVER, str(world.path)))
+    assert run.returncode == 0, run.stderr[-2000:]
+    result = json.loads(run.stdout)
+    assert result["steps"] == 10
+    assert result["finite_poses"] and result["finite_scans"]
+    assert result["neither_moved_nor_stalled"] == []
+    assert result["unsupported_type_warnings"] == dict.fromkeys(result["unsupported_types"], 1)
