@@ -18,6 +18,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
+from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.interrupts import sigterm_interrupts
 from stage_sim.ros.recording import recording
 from stage_sim.ros.session import parse_args
@@ -30,6 +31,7 @@ from stage_sim.worldfile.errors import WorldError
 def main(argv: list[str]) -> int:
     """Spin the simulator in a thread while the teleop reads the keyboard; 0 on Ctrl-C or at the duration."""
     args = parse_args(argv, "teleop.py", "rooms.world", __doc__.splitlines()[0])
+    use_private_domain("teleop.py")
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     nodes = []
     executor = SingleThreadedExecutor()

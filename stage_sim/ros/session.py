@@ -22,6 +22,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
+from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.stageros import StageRos
@@ -118,8 +119,10 @@ def parse_args(argv: list[str], prog: str, default_world: str, description: str)
 
 
 def wander_main(argv: list[str], prog: str, default_world: str, description: str) -> int:
-    """Run a wander session and print one JSON summary per robot at the end (also after Ctrl-C)."""
+    """Run a wander session (on a private DDS domain unless ROS_DOMAIN_ID is set); print one JSON summary per robot
+    at the end (also after Ctrl-C)."""
     args = parse_args(argv, prog, default_world, description)
+    use_private_domain(prog)
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     session = None
     try:

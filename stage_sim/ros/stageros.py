@@ -33,6 +33,7 @@ from tf2_msgs.msg import TFMessage
 from stage_sim.bags import fields
 from stage_sim.bags.names import RobotNames, robot_names
 from stage_sim.ros import conversions
+from stage_sim.ros.rival_publishers import RivalPublishers
 from stage_sim.sensing.kernels import resolve_threads
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world
@@ -107,6 +108,7 @@ class StageRos(Node):
         self.autostep = autostep
         self._timer = self._step_timer(autostep)
         self._publish_static()
+        self.rivals = RivalPublishers(self, ["/clock"], [t for n in self.names for t in (n.odom, *n.scans[:1])])
         self.get_logger().info(
             f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
             f"speedup {self.speedup:g}" + (" (as fast as possible)" if self.speedup <= 0 else ""))

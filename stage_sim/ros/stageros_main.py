@@ -17,10 +17,12 @@ os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from stage_sim.bags.errors import BagError
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
+from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.sensing.kernels import add_kernel_arguments
@@ -53,16 +55,20 @@ def main(argv: list[str] | None = None) -> int:
     args = parse_args(remove_ros_args(argv)[1:])
     from stage_sim.ros.stageros import StageRos
 
-    rclpy.init(args=argv)
+    # Ctrl-C/SIGTERM end the loop between spins: rclpy's own handlers shut the context down mid-step, and the
+    # step then fails to publish with a traceback.
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
-        node = StageRos(args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None,
-                        kernels=args.kernels, threads=args.threads)
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        with recording(node, args, "stageros"), viewing(node, args), bag_recording(node, args, "stageros"):
-            while rclpy.ok() and not node.finished:
-                executor.spin_once(timeout_sec=0.1)
+        with stop_requests() as stop:
+            node = StageRos(
+                args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None,
+                kernels=args.kernels, threads=args.threads)
+            executor = SingleThreadedExecutor()
+            executor.add_node(node)
+            with recording(node, args, "stageros"), viewing(node, args), bag_recording(node, args, "stageros"):
+                while rclpy.ok() and not node.finished and not stop.is_set():
+                    executor.spin_once(timeout_sec=0.1)
         return 0
     except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"stageros: {error}", file=sys.stderr)
