@@ -1,0 +1,29 @@
+"""``stageros`` on every corpus world: it comes up (publishing) within 10 s of CPU time and stops cleanly
+on Ctrl-C, or stops at once with exit status 2 and a file:line:col: message. Runs on the test session's
+private ROS domain, one world at a time, each in a memory-capped child."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from tests.corpus.children import CPU_BUDGET_S, LOCATED_MESSAGE, console_script, run_limited
+from tests.corpus.worlds_list import FAILS_TO_LOAD, STAGEROS_TOO_SLOW, World, params
+
+READY = re.compile(r"\[stageros\]: \S+: \d+ robot\(s\), interval_sim")
+
+
+@pytest.mark.parametrize("world", params(waiting=STAGEROS_TOO_SLOW))
+def test_stageros_comes_up_and_stops_on_ctrl_c(world: World) -> None:
+    run = run_limited([console_script("stageros"), str(world.path)], ready=READY)
+    assert run.returncode is not None, f"stageros still running after its wall timeout: {run.stderr[-500:]}"
+    assert "Traceback" not in run.stderr, run.stderr[-2000:]
+    if world.id in FAILS_TO_LOAD:
+        assert run.returncode == 2
+        assert run.stderr.startswith("stageros: ") and LOCATED_MESSAGE.match(run.stderr), run.stderr
+        assert FAILS_TO_LOAD[world.id] in run.stderr
+    else:
+        assert run.returncode == 0, run.stderr[-2000:]
+        assert READY.search(run.stderr)
+    assert run.cpu_seconds < CPU_BUDGET_S
