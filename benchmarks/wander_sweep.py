@@ -1,7 +1,7 @@
 """The wanderer on many seeds at once: stall events, longest stop and coverage per seed, then a summary.
 
 ``.venv/bin/python benchmarks/wander_sweep.py --seeds N --minutes M [--world W] [--jobs J] [--first-seed S]``
-runs ``launch_scripts/reactive.py W --duration 60*M --speedup 0 --seed s`` (lockstep: reproducible) for
+runs ``launch_scripts/reactive.py W --duration 60*M --speedup 0 --seed s -g`` (lockstep, no view) for
 seeds S..S+N-1, J processes at a time (default: one per core). Each run picks its own private ROS domain
 (ROS_DOMAIN_ID is removed from their environment), so runs never hear each other. Prints one JSON line
 per seed and robot, then one summary line per world; a seed falls short with a stall event, a stop over
@@ -31,7 +31,7 @@ def run_seed(world: str, seed: int, minutes: float) -> dict:
     env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     start = time.monotonic()
     command = [sys.executable, str(REACTIVE), world, "--duration", f"{minutes * 60:g}", "--speedup", "0",
-               "--seed", str(seed)]
+               "--seed", str(seed), "-g"]
     done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
     result = {"seed": seed, "wall_s": round(time.monotonic() - start, 1), "returncode": done.returncode}
     if done.returncode != 0:

@@ -16,7 +16,7 @@ READY = re.compile(r"\[stageros\]: \S+: \d+ robot\(s\), interval_sim")
 
 @pytest.mark.parametrize("world", params(waiting=STAGEROS_TOO_SLOW))
 def test_stageros_comes_up_and_stops_on_ctrl_c(world: World) -> None:
-    run = run_limited([console_script("stageros"), str(world.path)], ready=READY)
+    run = run_limited([console_script("stageros"), "-g", str(world.path)], ready=READY)
     assert run.returncode is not None, f"stageros still running after its wall timeout: {run.stderr[-500:]}"
     assert "Traceback" not in run.stderr, run.stderr[-2000:]
     if world.id in FAILS_TO_LOAD:

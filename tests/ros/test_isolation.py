@@ -21,7 +21,7 @@ REPO = Path(__file__).resolve().parents[2]
 REACTIVE = REPO / "launch_scripts" / "reactive.py"
 STAGEROS = Path(sys.executable).with_name("stageros")
 PRIVATE = re.compile(r"reactive\.py: on private ROS_DOMAIN_ID (\d+)")
-SESSION_ARGS = ["--duration", "20", "--speedup", "0", "--seed", "7"]
+SESSION_ARGS = ["--duration", "20", "--speedup", "0", "--seed", "7", "-g"]
 
 
 def without_domain() -> dict[str, str]:
@@ -86,7 +86,7 @@ def test_second_simulator_on_one_domain_is_reported_by_name(tmp_path: Path) -> N
     try:
         for world, log in zip(["rooms.world", "corridor.world"], logs, strict=True):
             with log.open("w") as sink:
-                processes.append(subprocess.Popen([str(STAGEROS), world], stdout=sink, stderr=subprocess.STDOUT))
+                processes.append(subprocess.Popen([str(STAGEROS), "-g", world], stdout=sink, stderr=subprocess.STDOUT))
             assert wait_for(log, "robot(s), interval_sim", 30.0), log.read_text()
         complaint = "another node named /stageros as well publishes /clock on ROS_DOMAIN_ID"
         assert wait_for(logs[1], complaint, 10.0), logs[1].read_text()
