@@ -25,8 +25,7 @@ NEEDS_SPARSE_WORLD = {
 """Worlds that exhaust memory until issue #14's sparse world lands (strict xfail: remove them then)."""
 
 STAGEROS_TOO_SLOW = {
-    "stage-worlds/benchmark/hospital.world": "waits for issue #14: stageros needs ~14 s of CPU to bring up 1000 robots",
-    "stage-worlds/fasr2.world": "waits for issue #14: stageros needs ~15 s of CPU to load and first step 100 robots",
+    "stage-worlds/benchmark/hospital.world": "stageros needs over 10 s of CPU to bring up 1000 robots (issue #14)",
 }
 """Worlds that load, but where stageros takes over 10 s of CPU to come up (strict xfail: remove them then)."""
 
