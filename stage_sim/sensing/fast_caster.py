@@ -7,11 +7,12 @@ and the final ranges) is done by the very numpy calls the reference makes.
 Memory per layer of H × W cells (rooms.world at 0.02 m: 1082 × 1352 = 1.46 M cells):
 
 * free squares, 4 quadrants × uint8: 4 B/cell (5.9 MB);
-* robot ids (only once robots are placed), int32: 4 B/cell (5.9 MB), plus two small block-count grids
-  (1/64 and 1/4096 of that).
+* robot ids (only once robots are placed), int32: 4 B/cell (5.9 MB), plus two small block grids
+  (1/64 of that each);
+* Stage's region grid: one bool per 32 × 32 cells.
 
-The numpy reference instead keeps, per layer, 4 uint8 square fields, 4 uint16 run-length fields and a
-padded int32 robot grid (17 B/cell with the padded occupancy copy), and builds them with int64 temporaries.
+The numpy reference keeps the same fields (its square fields stored mirrored per quadrant) and builds
+them with int32 temporaries.
 """
 
 from __future__ import annotations

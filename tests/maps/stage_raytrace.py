@@ -54,8 +54,11 @@ def region_grid(block_cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @numba.njit(cache=True)
-def raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm):
-    """(range, flat cell of ``layer`` or -1) of one ray from world point (x, y) at angle a."""
+def raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm, robots=None, owner=-1):
+    """(range, flat cell of ``layer`` or -1) of one ray from world point (x, y) at angle a.
+
+    ``robots`` (optional, ``layer``'s shape): a robot id per cell or -1; a robot's cell blocks the rays of
+    every other ``owner``."""
     globx = x * ppm
     globy = y * ppm
     startx, starty = globx, globy
@@ -84,7 +87,8 @@ def raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm):
             gx, gy = ix, iy
             while 0 <= cx < REGION and 0 <= cy < REGION and n > 0:
                 r, c = gy - row0, gx - col0
-                if 0 <= r < layer.shape[0] and 0 <= c < layer.shape[1] and layer[r, c]:
+                if 0 <= r < layer.shape[0] and 0 <= c < layer.shape[1] and (
+                        layer[r, c] or (robots is not None and robots[r, c] != -1 and robots[r, c] != owner)):
                     if ax > ay:
                         return abs((globx - startx) / cosa) / ppm, r * layer.shape[1] + c
                     return abs((globy - starty) / sina) / ppm, r * layer.shape[1] + c
