@@ -37,6 +37,7 @@ class RobotCells:
         self.shape = shape
         self._walk_grid = walk_grid
         self.regions = walk_grid.static_regions if walk_grid is not None else np.zeros((1, 1), dtype=bool)
+        self.region_squares = traversal.region_squares(self.regions)
         self.grid = np.full(shape, -1, dtype=np.int32)
         size = 1 << traversal.BLOCK
         self.blocks = np.full((-(-shape[0] // size), -(-shape[1] // size)), -1, dtype=np.int32)
@@ -55,9 +56,7 @@ class RobotCells:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``).
 
         Every robot's cells, seen at this height or not, make their regions non-empty (Stage counts blocks)."""
-        rows, cols, _ = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, None)
-        if self._walk_grid is not None:
-            self.regions = self._walk_grid.with_cells(rows, cols)
+        self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         flat = rows * self.shape[1] + cols
         traversal.write_robot_cells(self.grid, self.blocks, self._written, flat, ids.astype(np.int32), SEVERAL_ROBOTS)
@@ -67,6 +66,17 @@ class RobotCells:
             self.block_squares = traversal.square_fields(in_use)
         self._written = flat
         self.active = flat.size > 0
+
+    def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
+        """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
+        if self._walk_grid is None:
+            return
+        rows, cols, _ = visible_cells(cell_rows, cell_cols, np.zeros(np.size(cell_rows), dtype=np.int64), self.shape,
+                                      None)
+        regions = self._walk_grid.with_cells(rows, cols)
+        if not np.array_equal(regions, self.regions):
+            self.regions = regions
+            self.region_squares = traversal.region_squares(regions)
 
 
 class NumbaRayCaster:
@@ -95,7 +105,7 @@ class NumbaRayCaster:
                                          self.resolution, self.origin_xy)
         self._place = np.array([self._walk_grid.col0, self._walk_grid.row0, self._walk_grid.rcol0,
                                 self._walk_grid.rrow0], dtype=np.int64)
-        self._no_robots = RobotCells((1, 1))
+        self._no_robots = RobotCells((1, 1), self._walk_grid)
 
     def robot_layer(self) -> RobotCells:
         """An empty robot layer for this caster's grid."""
@@ -119,12 +129,12 @@ class NumbaRayCaster:
         packed = np.stack([rays.startx, rays.starty, rays.cosa, rays.sina, rays.tana, rays.dx, rays.dy])
         active = robots is not None and robots.active
         layer = robots if active else self._no_robots
-        regions = robots.regions if robots is not None else self._walk_grid.static_regions
+        regions = robots if robots is not None else self._no_robots
         walked = np.empty(n)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
-        args = (self._squares, layer.grid, active, layer.blocks, layer.block_squares, regions, self._place, packed,
-                rays.ppm, own, walked, cell, hit_robot)
+        args = (self._squares, layer.grid, active, layer.blocks, layer.block_squares, regions.regions,
+                regions.region_squares, self._place, packed, rays.ppm, own, walked, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
             traversal.cast_parallel(*args)

@@ -72,8 +72,7 @@ class RobotLayer:
         visible: np.ndarray | None = None,
     ) -> None:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
-        rows, cols, _ = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, None)
-        self.regions = self._walk_grid.with_cells(rows, cols)
+        self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         grid, blocks = self.grid.ravel(), self.blocks.ravel()
         old = self._written
@@ -88,6 +87,12 @@ class RobotLayer:
             self._block_squares = quadrant_square_fields(in_use).ravel()
         self._written = flat
         self.active = flat.size > 0
+
+    def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
+        """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
+        rows, cols, _ = visible_cells(cell_rows, cell_cols, np.zeros(np.size(cell_rows), dtype=np.int64), self.shape,
+                                      None)
+        self.regions = self._walk_grid.with_cells(rows, cols)
 
     def look(self, r, c, sx, sy, q, owner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """For walks standing in grid cells (r, c): (robot hit or -1, free cells ahead along x, along y, and

@@ -12,10 +12,13 @@ current cell the walk may take any number of steps that keep it inside
   uint8 per cell and quadrant; 0 marks an occupied cell);
 * the square of robot-free 8-cell blocks from the cell's block, when robots are about (or the cell's own
   block if no robot but the ray's own is there) (:class:`~stage_sim.sensing.fast_caster.RobotCells`);
-* the current region (Stage looks at the region again when the walk leaves one);
+* the largest square of regions holding blocks from the cell's region (:func:`region_squares`), and the
+  current region itself unless the cells Stage would look up afresh on crossing a region border are the
+  cells walked (:func:`_rereads_agree`);
 
-and within its remaining step count. Where the walk stands after i steps along x and j along y is known in
-closed form (:func:`walk_prefix`), so the jump lands on the very cell, error term and count of the walk.
+and within its remaining step count; the cell reached is free, so the next step follows at once. Where the
+walk stands after i steps along x and j along y is known in closed form (:func:`walk_prefix`), so the jump
+lands on the very cell, error term and count of the walk; short stretches are stepped through (cheaper).
 """
 
 from __future__ import annotations
@@ -30,6 +33,9 @@ from stage_sim.sensing.stage_walk import REGION, REGION_BITS
 
 #: Largest free-square side stored (uint8).
 SQUARE_CAP = 255
+#: Free stretches longer than this (steps) are crossed by :func:`walk_prefix`'s arithmetic, shorter ones
+#: step by step.
+JUMP_STEPS = 40
 #: Rays per work item of the parallel loop.
 _CHUNK = 64
 
@@ -50,15 +56,64 @@ def walk_prefix(e0, bx, by, mx, my, n):
     if room <= 0:
         i = 0
     elif by > 0:
-        i = min(i, (room - 1) // by + 1)
+        i = min(i, _floordiv(room - 1, by) + 1)
     if i > 0:
-        i = min(i, max(0, (n * bx + by - e0 - 1) // (bx + by)))
-    j = min((e0 + i * by) // bx + 1, my, n - i)
+        i = min(i, max(0, _floordiv(n * bx + by - e0 - 1, bx + by)))
+    j = min(_floordiv(e0 + i * by, bx) + 1, my, n - i)
     return i, j
 
 
+@numba.njit(inline="always", **_JIT)
+def _floordiv(a, b):
+    """``a // b`` for b > 0 (|a| < 2**50): a float division, corrected to the exact integer quotient."""
+    q = np.int64(math.floor(a / b))
+    if q * b > a:
+        q -= 1
+    elif (q + 1) * b <= a:
+        q += 1
+    return q
+
+
+@numba.njit(inline="always", **_JIT)
+def _step_through(e, bx, by, mx, my, n):
+    """:func:`walk_prefix` one step at a time: cheaper than its divisions for short stretches."""
+    i = j = 0
+    while n > 0:
+        if e < 0:
+            if i == mx:
+                break
+            i += 1
+            e += by
+        else:
+            if j == my:
+                break
+            j += 1
+            e -= bx
+        n -= 1
+    return i, j
+
+
+@numba.njit(inline="always", **_JIT)
+def _rereads_agree(basex, basey, kx, ky, gx, gy, di, dj):
+    """Whether Stage's fresh look at ``int(globx), int(globy)`` on crossing a region border gives the cell walked.
+
+    It does unless a coordinate changes sign on the way or ``base + k`` rounds onto a whole number; both would
+    show at one end of the stretch (the truncation is monotonic in the magnitude), so both ends are checked.
+    """
+    return (int(basex + kx) == gx and int(basey + ky) == gy and int(basex + (kx + di)) == gx + di
+            and int(basey + (ky + dj)) == gy + dj)
+
+
+@numba.njit(inline="always", **_JIT)
+def _prefix(e, bx, by, mx, my, n):
+    """:func:`walk_prefix`, step by step for short stretches (cheaper than its divisions)."""
+    if mx + my > JUMP_STEPS:
+        return walk_prefix(e, bx, by, mx, my, n)
+    return _step_through(e, bx, by, mx, my, n)
+
+
 @numba.njit(**_JIT)
-def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, col0, row0, rcol0, rrow0,
+def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region_squares, col0, row0, rcol0, rrow0,
              startx, starty, cosa, sina, tana, dx, dy, ppm, owner):
     """(range in metres or inf, flat cell or -1, robot id or -1) of one ray walked as Stage walks it."""
     h, w = squares.shape[1], squares.shape[2]
@@ -111,19 +166,32 @@ def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, col0, 
                     if k == 0:
                         return _distance(ax, ay, basex + kx, basey + ky, startx, starty, cosa, sina, ppm), r * w + c, -1
                 if k > 1:
-                    mx = min(k, kbx, REGION - cx if sx > 0 else cx + 1) - 1
-                    my = min(k, kby, REGION - cy if sy > 0 else cy + 1) - 1
-                    i, j = walk_prefix(exy, bx, by, mx, my, n)
+                    gx, gy = c + col0, r + row0
+                    rgx, rgy = gx >> REGION_BITS, gy >> REGION_BITS
+                    side = np.int64(region_squares[quadrant, rgy - rrow0, rgx - rcol0])
+                    krx = ((rgx + side) << REGION_BITS) - gx if sx >= 0 else gx + 1 - ((rgx - side + 1) << REGION_BITS)
+                    kry = ((rgy + side) << REGION_BITS) - gy if sy >= 0 else gy + 1 - ((rgy - side + 1) << REGION_BITS)
+                    mx = min(k, kbx, krx) - 1
+                    my = min(k, kby, kry) - 1
+                    i, j = _prefix(exy, bx, by, mx, my, n)
+                    ex, ey = cx + i * sx, cy + j * sy
+                    if not (0 <= ex < REGION and 0 <= ey < REGION) and not _rereads_agree(
+                            basex, basey, kx, ky, gx, gy, i * sx, j * sy):
+                        mx = min(mx, REGION - 1 - cx if sx > 0 else cx)
+                        my = min(my, REGION - 1 - cy if sy > 0 else cy)
+                        i, j = _prefix(exy, bx, by, mx, my, n)
                     if i + j > 0:
                         kx += i * sx
-                        cx += i * sx
                         c += i * sx
                         ky += j * sy
-                        cy += j * sy
                         r += j * sy
+                        cx = (c + col0) & (REGION - 1)
+                        cy = (r + row0) & (REGION - 1)
                         exy += i * by - j * bx
                         n -= i + j
-                        continue
+                        if n <= 0:
+                            continue
+                        # Stage looks at this cell too: free (inside the square), so on with the next step.
                 if exy < 0:
                     kx += sx
                     exy += by
@@ -179,32 +247,33 @@ def _distance(ax, ay, globx, globy, startx, starty, cosa, sina, ppm):
 
 
 @numba.njit(**_JIT)
-def _cast_range(squares, robots, use_robots, blocks, block_squares, regions, place, rays, ppm, owner, out, cell, rid,
-                a, b):
+def _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
+                out, cell, rid, a, b):
     col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
     startx, starty, cosa, sina, tana, dx, dy = rays[0], rays[1], rays[2], rays[3], rays[4], rays[5], rays[6]
     for i in range(a, b):
-        out[i], cell[i], rid[i] = walk_ray(squares, robots, use_robots, blocks, block_squares, regions, col0, row0,
-                                           rcol0, rrow0, startx[i], starty[i], cosa[i], sina[i], tana[i], dx[i],
-                                           dy[i], ppm, owner[i])
+        out[i], cell[i], rid[i] = walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region_squares,
+                                           col0, row0, rcol0, rrow0, startx[i], starty[i], cosa[i], sina[i], tana[i],
+                                           dx[i], dy[i], ppm, owner[i])
 
 
 @numba.njit(**_JIT)
-def cast_serial(squares, robots, use_robots, blocks, block_squares, regions, place, rays, ppm, owner, out, cell, rid):
+def cast_serial(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
+                out, cell, rid):
     """Every ray in order, on the calling thread. ``rays``: (7, N) startx, starty, cos, sin, tan, dx, dy;
     ``place``: col0, row0, rcol0, rrow0 of :class:`~stage_sim.sensing.stage_walk.WalkGrid`."""
-    _cast_range(squares, robots, use_robots, blocks, block_squares, regions, place, rays, ppm, owner, out, cell, rid,
-                0, owner.size)
+    _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
+                out, cell, rid, 0, owner.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(squares, robots, use_robots, blocks, block_squares, regions, place, rays, ppm, owner, out, cell,
-                  rid):
+def cast_parallel(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
+                  out, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(squares, robots, use_robots, blocks, block_squares, regions, place, rays, ppm, owner, out, cell,
-                    rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
+        _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm,
+                    owner, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
 
 
 @numba.njit(**_JIT)
@@ -237,6 +306,14 @@ def square_fields(occupied):
                     side = min(side, np.int64(out[q, yn, xn]))
                 out[q, y, x] = min(side + 1, SQUARE_CAP)
     return out
+
+
+def region_squares(regions: np.ndarray) -> np.ndarray:
+    """(4, R, C) uint8: side of the largest square of regions holding blocks from each region, per quadrant
+    (0 for an empty region; regions beyond the grid are empty)."""
+    padded = np.ones((regions.shape[0] + 2, regions.shape[1] + 2), dtype=np.bool_)
+    padded[1:-1, 1:-1] = ~regions
+    return np.ascontiguousarray(square_fields(padded)[:, 1:-1, 1:-1])
 
 
 @numba.njit(**_JIT)

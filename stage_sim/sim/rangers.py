@@ -133,7 +133,10 @@ class RangerSensing:
         layer = None
         if robot_cells is not None:
             width = self._grid.shape[1]
-            group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+            if self._bodies.count > 1:
+                group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+            else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
+                group.robots.mark_regions(robot_cells // width, robot_cells % width)
             layer = group.robots
         result = group.caster.cast(origins, angles, self._max_range[rays], owners=owner, robots=layer)
         ranges[rays] = result.ranges
