@@ -92,11 +92,16 @@ class WalkRays:
     def build(cls, xy: np.ndarray, angles: np.ndarray, max_ranges: np.ndarray, resolution: float) -> WalkRays:
         """Constants of rays from world points ``xy`` (N, 2) at ``angles`` reaching ``max_ranges`` metres."""
         ppm = 1.0 / resolution
-        angle = np.where(angles == 0.0, ZERO_ANGLE, angles)
-        cosa, sina = np.cos(angle), np.sin(angle)
+        cosa, sina = beam_cos_sin(angles)
         reach = ppm * max_ranges
         return cls(np.ascontiguousarray(xy[:, 0] * ppm), np.ascontiguousarray(xy[:, 1] * ppm), cosa, sina,
                    sina / cosa, reach * cosa, reach * sina, ppm)
+
+
+def beam_cos_sin(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of the beam angles, an angle of exactly 0 turned into :data:`ZERO_ANGLE` as Stage does."""
+    angle = np.where(angles == 0.0, ZERO_ANGLE, angles)
+    return np.cos(angle), np.sin(angle)
 
 
 def finish_ranges(walked: np.ndarray, max_ranges: np.ndarray) -> np.ndarray:

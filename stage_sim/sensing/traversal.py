@@ -247,33 +247,37 @@ def _distance(ax, ay, globx, globy, startx, starty, cosa, sina, ppm):
 
 
 @numba.njit(**_JIT)
-def _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
-                out, cell, rid, a, b):
+def _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
+                rmax, ppm, owner, out, cell, rid, a, b):
     col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
-    startx, starty, cosa, sina, tana, dx, dy = rays[0], rays[1], rays[2], rays[3], rays[4], rays[5], rays[6]
     for i in range(a, b):
-        out[i], cell[i], rid[i] = walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region_squares,
-                                           col0, row0, rcol0, rrow0, startx[i], starty[i], cosa[i], sina[i], tana[i],
-                                           dx[i], dy[i], ppm, owner[i])
+        c, s = cosa[i], sina[i]
+        reach = ppm * rmax[i]  # the arithmetic of stage_walk.WalkRays, operation for operation
+        walked, cell[i], rid[i] = walk_ray(squares, robots, use_robots, blocks, block_squares, regions,
+                                           region_squares, col0, row0, rcol0, rrow0, xy[i, 0] * ppm, xy[i, 1] * ppm,
+                                           c, s, s / c, reach * c, reach * s, ppm, owner[i])
+        out[i] = walked if cell[i] >= 0 else rmax[i]
 
 
 @numba.njit(**_JIT)
-def cast_serial(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
-                out, cell, rid):
-    """Every ray in order, on the calling thread. ``rays``: (7, N) startx, starty, cos, sin, tan, dx, dy;
+def cast_serial(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
+                rmax, ppm, owner, out, cell, rid):
+    """Every ray in order, on the calling thread: ranges in metres (exactly ``rmax`` on a miss) into ``out``.
+
+    ``cosa``, ``sina``: of Stage's beam angles (:func:`~stage_sim.sensing.stage_walk.beam_cos_sin`);
     ``place``: col0, row0, rcol0, rrow0 of :class:`~stage_sim.sensing.stage_walk.WalkGrid`."""
-    _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
-                out, cell, rid, 0, owner.size)
+    _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
+                rmax, ppm, owner, out, cell, rid, 0, owner.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm, owner,
-                  out, cell, rid):
+def cast_parallel(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
+                  rmax, ppm, owner, out, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, rays, ppm,
-                    owner, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
+        _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa,
+                    sina, rmax, ppm, owner, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
 
 
 @numba.njit(**_JIT)
