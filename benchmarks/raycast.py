@@ -2,10 +2,10 @@
 
 Run with the project's venv python: ``.venv/bin/python benchmarks/raycast.py``. Prints one JSON object per
 line, pinned to one core: ``rays_per_s`` (numpy caster), ``numba_rays_per_s`` (the simulator's compiled
-kernel, :mod:`stage_sim.sensing.traversal`), ``reference_rays_per_s`` (the plain Amanatides–Woo walk
-below) and their ratios; ``agree``: share of rays whose hit cell equals the reference's (its accumulated
-crossing times round differently from the casters' exact ones on a few rays); ``numba_identical``: whether
-the numba kernel's answers equal the numpy caster's bit for bit.
+kernel, :mod:`stage_sim.sensing.traversal`), ``reference_rays_per_s`` (Stage's walk visiting every cell,
+the tests' plain port of ``World::Raytrace``) and their ratios; ``agree``: share of rays whose hit cell
+equals the reference's; ``numba_identical``: whether the numba kernel's answers equal the numpy caster's
+bit for bit.
 """
 
 from __future__ import annotations
@@ -26,6 +26,11 @@ import numpy as np
 from stage_sim.maps.polygon_raster import outline_points, point_cells
 from stage_sim.sensing.casters import make_caster
 
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from tests.maps.stage_raytrace import raytrace, region_grid  # noqa: E402
+
 RESOLUTION = 0.02  # metres per cell, Stage's default raytrace resolution
 MAP_RESOLUTION = 0.05  # metres per pixel of the bitmaps in maps/
 POSES = 100
@@ -36,45 +41,11 @@ CASES = ((240, 240.0, 5.6), (1081, 270.0, 30.0))
 
 
 @numba.njit(cache=True)
-def amanatides_woo(occ, robot, res, gx, gy, xs, ys, angles, rmax, owners, out_range, out_cell):
-    """Reference: one classic traversal per ray (tMax += tDelta), minor axis first on ties."""
-    h, w = occ.shape
+def plain_stage_walk(occ, robot, regions, res, xs, ys, angles, rmax, owners, out_range, out_cell):
+    """Reference: Stage's walk, one ray at a time, every cell visited (the tests' port of World::Raytrace)."""
     for i in range(xs.shape[0]):
-        u = (xs[i] - gx) / res
-        v = (ys[i] - gy) / res
-        dx = math.cos(angles[i]) + 0.0
-        dy = math.sin(angles[i]) + 0.0
-        ix = math.floor(u)
-        iy = math.floor(v)
-        sx = 1 if dx >= 0 else -1
-        sy = 1 if dy >= 0 else -1
-        idx = 1.0 / dx if dx != 0 else math.inf
-        idy = 1.0 / dy if dy != 0 else math.inf
-        tmx = ((ix + (1 if sx > 0 else 0)) - u) * idx
-        tmy = ((iy + (1 if sy > 0 else 0)) - v) * idy
-        tdx = abs(idx)
-        tdy = abs(idy)
-        xmaj = abs(dx) >= abs(dy)
-        rc = rmax / res
-        t = 0.0
-        out_range[i] = rmax
-        out_cell[i] = -1
-        while 0 <= ix < w and 0 <= iy < h:
-            rid = robot[iy, ix]
-            if occ[iy, ix] or (rid != -1 and rid != owners[i]):
-                out_range[i] = t * res
-                out_cell[i] = iy * w + ix
-                break
-            if tmx < tmy or (tmx == tmy and not xmaj):
-                t = tmx
-                tmx += tdx
-                ix += sx
-            else:
-                t = tmy
-                tmy += tdy
-                iy += sy
-            if t >= rc:
-                break
+        out_range[i], out_cell[i] = raytrace(occ, 0, 0, regions, 0, 0, xs[i], ys[i], angles[i], rmax, 1.0 / res,
+                                             robot, owners[i])
 
 
 def load_map(name: str) -> tuple[np.ndarray, str]:
@@ -140,9 +111,12 @@ def best_of(fn, repeats: int = REPEATS) -> float:
 def reference(occ, robot, xy, angles, rmax, owners):
     rng_out = np.empty(len(angles))
     cell_out = np.empty(len(angles), dtype=np.int64)
+    rows, cols = np.nonzero(occ | (robot != -1))
+    regions, low = region_grid(np.stack([cols, rows], axis=1))
+    regions = np.pad(regions, ((low[1], 0), (low[0], 0)))  # region (0, 0) at cell (0, 0), as the casters'
 
     def run():
-        amanatides_woo(occ, robot, RESOLUTION, 0.0, 0.0, xy[:, 0], xy[:, 1], angles, rmax, owners, rng_out, cell_out)
+        plain_stage_walk(occ, robot, regions, RESOLUTION, xy[:, 0], xy[:, 1], angles, rmax, owners, rng_out, cell_out)
 
     return run, rng_out, cell_out
 

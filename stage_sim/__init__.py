@@ -7,7 +7,7 @@ Dependencies point one way only, top to bottom (enforced by import-linter, ``.im
     runs | rendering | view | bags              uses of a running simulation
     wander                                      the reactive controller (never imports sim)
     sim                                         Simulation: robots, kinematics, odometry, collision
-    sensing                                     exact ray casting on the grid
+    sensing                                     ray casting on the grid, Stage's walk
     maps                                        the static world rasterised
     worldfile                                   .world/.inc/bitmap/YAML → WorldDescription
 

@@ -91,6 +91,16 @@ class StaticRaster:
         return self._cache["any"]
 
     @property
+    def blocks(self) -> np.ndarray:
+        """Cells of any static body's raster, whatever its height or flags: where Stage's regions hold blocks."""
+        if "blocks" not in self._cache:
+            blocks = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
+            for body in self.bodies:
+                blocks[body.outline] = True
+            self._cache["blocks"] = blocks.reshape(self.shape)
+        return self._cache["blocks"]
+
+    @property
     def occupied_cell_count(self) -> int:
         """How many cells the filled footprints cover."""
         return int(self.occupied.sum())

@@ -15,11 +15,13 @@ if TYPE_CHECKING:
 
 def make_caster(
     occupied: np.ndarray, resolution: float, origin_xy: tuple[float, float], kernels: str | None = None,
-    threads: int = 1,
+    threads: int = 1, blocks: np.ndarray | None = None,
 ) -> GridRayCaster | NumbaRayCaster:
-    """A ray caster for one static layer, of the implementation :func:`resolve_kernels` picks."""
+    """A ray caster for one static layer, of the implementation :func:`resolve_kernels` picks.
+
+    ``blocks``: the cells of every static block at any height (Stage skips regions without one)."""
     if resolve_kernels(kernels) == "numba":
         from stage_sim.sensing.fast_caster import NumbaRayCaster
 
-        return NumbaRayCaster(occupied, resolution, origin_xy, threads)
-    return GridRayCaster(occupied, resolution, origin_xy)
+        return NumbaRayCaster(occupied, resolution, origin_xy, threads, blocks)
+    return GridRayCaster(occupied, resolution, origin_xy, blocks)

@@ -1,7 +1,7 @@
-"""Free-space certificates for the grid ray caster (:mod:`stage_sim.sensing.raycast`).
+"""Free-space certificates for the numpy ray caster (:mod:`stage_sim.sensing.raycast`).
 
-Everything here answers "how far is it certainly free from this cell?" so that the caster can jump
-over free space in a few vectorised steps instead of visiting every cell.
+Everything here answers "how far is it certainly free from this cell?" so that the walk can cross free
+space in one vectorised step instead of visiting every cell.
 
 * :func:`quadrant_square_fields` – for each cell ``c`` and each of the four diagonal quadrants
   ``(sx, sy)``, the side ``k`` of the largest free square that has ``c`` as its corner and extends
@@ -12,11 +12,8 @@ over free space in a few vectorised steps instead of visiting every cell.
   slow it down. Computed by the classic "largest square" recurrence
   ``k(c) = 1 + min(k(c+x), k(c+y), k(c+x+y))``, one row at a time (the row recurrence is a reversed
   running minimum, so every row is a handful of numpy calls).
-* :func:`run_lengths` – for each cell and each of the four axis directions, how many consecutive
-  free cells start at that cell (0 if it is occupied). The caster uses them to test a whole straight
-  stretch of a ray (all the cells it visits in one row or column) with a single lookup.
 
-The grids passed in are already padded by the caller; cells outside the array count as free.
+Cells outside the array count as free.
 """
 
 from __future__ import annotations
@@ -25,8 +22,6 @@ import numpy as np
 
 #: Largest square side stored (uint8). A longer free stretch simply takes one more jump.
 SQUARE_CAP = 255
-#: Run lengths are capped at the largest uint16, longer than any map edge we rasterise.
-RUN_CAP = 65535
 
 
 def quadrant_square_fields(occupied: np.ndarray) -> np.ndarray:
@@ -56,23 +51,4 @@ def quadrant_square_fields(occupied: np.ndarray) -> np.ndarray:
         np.minimum(side, SQUARE_CAP, out=side)
         out[:, y] = side[:, :w]
         prev = side
-    return out
-
-
-def run_lengths(occupied: np.ndarray) -> np.ndarray:
-    """Return ``(4, H, W)`` uint16 free-run lengths towards +x, −x, +y, −y (in that order)."""
-    occ = np.asarray(occupied, dtype=bool)
-    h, w = occ.shape
-    out = np.empty((4, h, w), dtype=np.uint16)
-    big = np.int64(RUN_CAP) + max(h, w)
-    xs = np.arange(w, dtype=np.int64)[None, :]
-    ys = np.arange(h, dtype=np.int64)[:, None]
-    nxt = np.minimum.accumulate(np.where(occ, xs, w + big)[:, ::-1], axis=1)[:, ::-1]
-    out[0] = np.minimum(nxt - xs, RUN_CAP)
-    prv = np.maximum.accumulate(np.where(occ, xs, -1 - big), axis=1)
-    out[1] = np.minimum(xs - prv, RUN_CAP)
-    nxt = np.minimum.accumulate(np.where(occ, ys, h + big)[::-1, :], axis=0)[::-1, :]
-    out[2] = np.minimum(nxt - ys, RUN_CAP)
-    prv = np.maximum.accumulate(np.where(occ, ys, -1 - big), axis=0)
-    out[3] = np.minimum(ys - prv, RUN_CAP)
     return out

@@ -104,7 +104,8 @@ class RangerSensing:
         ray_due = due[self._ranger_of_ray]
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
-        robot_cells = self._bodies.point_cells(poses, self._grid) if self._bodies.count > 1 else None
+        # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
+        robot_cells = self._bodies.point_cells(poses, self._grid) if self._bodies.count else None
         jitter = self._angle_jitter(ray_due)
         for group in self._groups:
             rays = group.rays[ray_due[group.rays]]
@@ -132,7 +133,10 @@ class RangerSensing:
         layer = None
         if robot_cells is not None:
             width = self._grid.shape[1]
-            group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+            if self._bodies.count > 1:
+                group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+            else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
+                group.robots.mark_regions(robot_cells // width, robot_cells % width)
             layer = group.robots
         result = group.caster.cast(origins, angles, self._max_range[rays], owners=owner, robots=layer)
         ranges[rays] = result.ranges
@@ -178,7 +182,7 @@ class RangerSensing:
         for height in np.unique(ray_height):
             occupied, intensity = static.sensing_layer(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
-            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
+            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads, static.blocks)
             groups.append(_HeightGroup(
                 rays=np.flatnonzero(ray_height == height),
                 caster=caster,

@@ -1,8 +1,9 @@
 """Stage 4.3's ray walk (``World::Raytrace`` in libstage/world.cc), ported statement by statement.
 
-A test reference, not a simulator part: run on stage_sim's static raster it reproduces Stage's recorded
-scans only if that raster holds exactly Stage's cells. What it does differently from stage_sim's exact
-traversal (and why the golden scans differ from stage_sim's by up to a cell):
+The test oracle for stage_sim's casters, which walk the same way (:mod:`stage_sim.sensing.stage_walk`)
+but skip free space and handle robots: this port visits every cell, plainly. Run on stage_sim's static
+raster it also reproduces Stage's recorded scans, if that raster holds exactly Stage's cells. What it
+does (and what differs from the distance to where the true ray enters the first occupied cell):
 
 * the walk is Cohen's integer line: ``ax = (int)|dx|``, ``ay = (int)|dy|`` cells to go, error term
   ``ay − ax`` to start with, so the cells visited are those of a line through the *centre* of the start
@@ -31,23 +32,33 @@ def stage_ray_ranges(
     """Ranges of one Stage scan. ``layer[row, col]`` is the grid of cells a ray stops at, its cell (0, 0)
     being Stage's cell ``offset`` (col, row); ``block_cells`` (K, 2) are the Stage cells of every block in
     the world (the scanning robot's own included), which decide which regions are empty."""
-    region_low = np.floor_divide(block_cells.min(axis=0), REGION)
-    region_high = np.floor_divide(block_cells.max(axis=0), REGION)
-    regions = np.zeros((region_high[1] - region_low[1] + 1, region_high[0] - region_low[0] + 1), dtype=np.bool_)
-    index = np.floor_divide(block_cells, REGION) - region_low
-    regions[index[:, 1], index[:, 0]] = True
+    regions, region_low = region_grid(block_cells)
     ppm = 1.0 / resolution
     start = fov / 2.0 - yaw
     ranges = np.empty(samples)
     for s in range(samples):
         angle = (s * fov / (samples - 1)) - start if samples > 1 else yaw
-        ranges[s] = _raytrace(layer, int(offset[0]), int(offset[1]), regions, int(region_low[0]),
-                              int(region_low[1]), origin[0], origin[1], angle, range_max, ppm)
+        ranges[s] = raytrace(layer, int(offset[0]), int(offset[1]), regions, int(region_low[0]),
+                             int(region_low[1]), origin[0], origin[1], angle, range_max, ppm)[0]
     return ranges
 
 
+def region_grid(block_cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(regions holding a block, region (col, row) of regions[0, 0]) of Stage cells ``block_cells`` (K, 2)."""
+    region_low = np.floor_divide(block_cells.min(axis=0), REGION)
+    region_high = np.floor_divide(block_cells.max(axis=0), REGION)
+    regions = np.zeros((region_high[1] - region_low[1] + 1, region_high[0] - region_low[0] + 1), dtype=np.bool_)
+    index = np.floor_divide(block_cells, REGION) - region_low
+    regions[index[:, 1], index[:, 0]] = True
+    return regions, region_low
+
+
 @numba.njit(cache=True)
-def _raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm):
+def raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm, robots=None, owner=-1):
+    """(range, flat cell of ``layer`` or -1) of one ray from world point (x, y) at angle a.
+
+    ``robots`` (optional, ``layer``'s shape): a robot id per cell or -1; a robot's cell blocks the rays of
+    every other ``owner``."""
     globx = x * ppm
     globy = y * ppm
     startx, starty = globx, globy
@@ -76,10 +87,11 @@ def _raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm)
             gx, gy = ix, iy
             while 0 <= cx < REGION and 0 <= cy < REGION and n > 0:
                 r, c = gy - row0, gx - col0
-                if 0 <= r < layer.shape[0] and 0 <= c < layer.shape[1] and layer[r, c]:
+                if 0 <= r < layer.shape[0] and 0 <= c < layer.shape[1] and (
+                        layer[r, c] or (robots is not None and robots[r, c] != -1 and robots[r, c] != owner)):
                     if ax > ay:
-                        return abs((globx - startx) / cosa) / ppm
-                    return abs((globy - starty) / sina) / ppm
+                        return abs((globx - startx) / cosa) / ppm, r * layer.shape[1] + c
+                    return abs((globy - starty) / sina) / ppm, r * layer.shape[1] + c
                 if exy < 0:
                     globx += sx
                     exy += by
@@ -123,4 +135,4 @@ def _raytrace(layer, col0, row0, regions, rcol0, rrow0, x, y, a, range_max, ppm)
                 ycrossy += yjumpy
                 dist_x -= dist_y
                 dist_y = yjumpdist
-    return range_max
+    return range_max, -1

@@ -5,12 +5,8 @@ Two questions per variant (A: rooms.world, B: at resolution 0.05, C: floorplan t
 * Does the static raster hold Stage's cells? Stage's own ray walk, replayed on stage_sim's raster
   (:mod:`tests.maps.stage_raytrace`), must give Stage's recorded ranges to the millimetre.
 * Do stage_sim's own scans meet the issue's goals (within 1 cell >= 95 %, within 1.5 cells >= 99 %, mean
-  Stage − stage_sim on beams both hit within ±0.2 cell, hit/miss disagreements <= 0.05 %)? Not yet: the
-  raster is Stage's, but the ray traversal returns the exact distance to the entry of the first occupied
-  cell along the true ray, while Stage walks an integer line from the centre of the start cell and reports
-  the distance travelled along the major axis (one cell further on rays going towards −x / −y once it has
-  skipped an empty region). That test is marked as an expected failure, strictly, so that it turns into a
-  failure to clean up the day the traversal follows Stage (README, "How close to Stage").
+  Stage − stage_sim on beams both hit within ±0.2 cell, hit/miss disagreements <= 0.05 %)? They do since
+  the casters walk as Stage walks (:mod:`stage_sim.sensing.stage_walk`).
 
 Run with ``-s`` to see the figures.
 """
@@ -55,7 +51,6 @@ def test_stages_ray_walk_on_our_raster_gives_stages_scans(recorded) -> None:
     assert abs(result.mean_diff_cells) <= 0.01
 
 
-@pytest.mark.xfail(strict=True, reason="the ray traversal is exact, Stage's is not (see the module docstring)")
 def test_stage_sim_scans_meet_the_goals(recorded) -> None:
     variant, golden, stage = recorded
     result = report(figures(variant, "stage_sim", stage, stage_sim_scans(golden), RESOLUTION[variant], RANGE_MAX))

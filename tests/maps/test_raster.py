@@ -102,12 +102,13 @@ define laser ranger ( sensor( range [0 5] fov 180 samples 3 ) size [0.05 0.05 0.
 position( name "r" size [0.1 0.1 0.1] pose [4.05 2.05 0 180] obstacle_return 0 laser( pose [0 0 0 0] ) )
 """
     sim = Simulation(load_world_text(world, "w.world"), seed=0)
-    # facing −x from x = 4.05 at y = 2.05: the east wall's cells are column 25 = [2.5, 2.6)
-    assert math.isclose(sim.scans[0][0].ranges[1], 4.05 - 2.6, abs_tol=1e-6)
+    # facing −x from x = 4.05 at y = 2.05: the east wall's cells are column 25 = [2.5, 2.6); Stage's walk
+    # reports the whole cells walked from the origin's cell 40 to it (15), not the true ray's 1.45 m
+    assert math.isclose(sim.scans[0][0].ranges[1], 1.5, abs_tol=1e-6)
     sim.set_pose(0, 2.05, 2.05, math.pi)
     sim.step()
-    # from inside, facing −x: the west wall's cells are column 15 = [1.5, 1.6): the ray stops at 1.6
-    assert math.isclose(sim.scans[0][0].ranges[1], 2.05 - 1.6, abs_tol=1e-6)
+    # from inside, facing −x: the west wall's cells are column 15 = [1.5, 1.6): 5 cells from cell 20
+    assert math.isclose(sim.scans[0][0].ranges[1], 0.5, abs_tol=1e-6)
 
 
 def test_a_robot_inside_a_big_obstacle_but_clear_of_its_edges_does_not_collide() -> None:

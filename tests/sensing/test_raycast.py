@@ -1,13 +1,10 @@
-"""Exactness of the vectorised grid ray caster against two independent references.
+"""The grid ray casters walk as Stage walks (``World::Raytrace``), cell for cell.
 
-* ``traverse``: a plain per-cell Amanatides–Woo walk in pure Python with the formulas of the module
-  docstring (crossing times computed fresh, minor axis first on ties). The caster must return the
-  same hit cell and the same distance (to 1e-9 m) for every ray.
-* ``sample``: brute force, no grid-line arithmetic at all: points every ``step`` << cell along the
-  ray, each mapped to its cell; the entry into the first occupied sample's cell is then solved for
-  exactly. A sampler can step over a cell that the ray only clips near a corner (when one step
-  crosses a vertical and a horizontal grid line); such rays are detected, counted and required to
-  be rare, all others must agree to 1e-6 m.
+The reference is the plain, statement-by-statement port of Stage's walk (:mod:`tests.maps.stage_raytrace`,
+every cell visited, no free-space skipping); robots are folded into its grid per ray (every robot cell but
+the ray's owner's blocks), and every cell holding a block or a robot makes its region non-empty. The casters
+must return the same hit cell and the same range (to 1e-9 m) for every ray. Explicit values check what
+Stage reports where it differs from the true ray: whole cells walked from the origin along the major axis.
 """
 
 from __future__ import annotations
@@ -19,70 +16,23 @@ import pytest
 
 from stage_sim.maps.polygon_raster import fill_polygon
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
+from tests.maps.stage_raytrace import raytrace, region_grid
 
 RES = 0.05
 ORIGIN = (-1.25, 0.75)
 
 
-def traverse(occupied, res, origin, x, y, angle, rmax):
-    """Reference traversal; ``occupied(row, col)`` says whether a cell blocks. Returns (range, cell)."""
-    h, w = occupied.shape if hasattr(occupied, "shape") else occupied.grid_shape
-    is_occ = occupied.__getitem__ if hasattr(occupied, "shape") else occupied
-    u = (x - origin[0]) / res
-    v = (y - origin[1]) / res
-    dx = math.cos(angle) + 0.0
-    dy = math.sin(angle) + 0.0
-    idx = 1.0 / dx if dx != 0 else math.inf
-    idy = 1.0 / dy if dy != 0 else math.inf
-    x_major = abs(dx) >= abs(dy)
-    sx = 1 if dx >= 0 else -1
-    sy = 1 if dy >= 0 else -1
-    ix, iy = math.floor(u), math.floor(v)
-    t = 0.0
-    while True:
-        if 0 <= ix < w and 0 <= iy < h and is_occ((iy, ix)):
-            return t * res, iy * w + ix
-        tx = ((ix + (sx > 0)) - u) * idx
-        ty = ((iy + (sy > 0)) - v) * idy
-        if (tx < ty) if x_major else (tx <= ty):
-            t, ix = tx, ix + sx
-        else:
-            t, iy = ty, iy + sy
-        if t >= rmax / res:
-            return rmax, -1
-
-
-def sample(occ, res, origin, x, y, angle, rmax, step):
-    """Brute-force (range, cell, clipped_corner) by sampling; see the module docstring."""
-    h, w = occ.shape
-    dx, dy = math.cos(angle), math.sin(angle)
-    t = np.arange(0.0, rmax, step)
-    col = np.floor((x + t * dx - origin[0]) / res).astype(np.int64)
-    row = np.floor((y + t * dy - origin[1]) / res).astype(np.int64)
-    inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
-    blocked = np.zeros(t.size, dtype=bool)
-    blocked[inside] = occ[row[inside], col[inside]]
-    # A step that changes both the row and the column skips the cell between them: if that cell is
-    # occupied (and the sampler did not stop before), the sampler is provably wrong there.
-    both = np.flatnonzero((np.diff(col) != 0) & (np.diff(row) != 0))
-    hits = np.flatnonzero(blocked)
-    first = hits[0] if hits.size else t.size
-    for i in both[both < first]:
-        for r, c in ((row[i], col[i + 1]), (row[i + 1], col[i])):
-            if 0 <= r < h and 0 <= c < w and occ[r, c]:
-                return None, None, True
-    if not hits.size:
-        return rmax, -1, False
-    if first == 0:
-        return 0.0, row[0] * w + col[0], False
-    # Entry into the hit cell: through the grid line between the previous sample's cell and it.
-    if col[first] != col[first - 1]:
-        line = max(col[first], col[first - 1])
-        entry = (origin[0] + line * res - x) / dx
-    else:
-        line = max(row[first], row[first - 1])
-        entry = (origin[1] + line * res - y) / dy
-    return entry, row[first] * w + col[first], False
+def stage_walk(occupied, res, origin, x, y, angle, rmax, blocks=None):
+    """Stage's (range, hit cell) of one ray; ``blocks``: the cells that make regions non-empty (default occupied)."""
+    col0, row0 = round(origin[0] / res), round(origin[1] / res)
+    rows, cols = np.nonzero(occupied if blocks is None else blocks)
+    cells = np.stack([cols + col0, rows + row0], axis=1) if rows.size else np.array([[col0, row0]])
+    regions, low = region_grid(cells)
+    if rows.size == 0:
+        regions[:] = False
+    walked, cell = raytrace(np.asarray(occupied, dtype=np.bool_), col0, row0, regions, int(low[0]), int(low[1]), x, y,
+                            angle, rmax, 1.0 / res)
+    return walked, cell
 
 
 def polygon_cells(polygons, res, origin, shape):
@@ -118,23 +68,18 @@ def random_rays(rng, occ, n, margin=0.5):
     return xy, rng.uniform(-2 * math.pi, 2 * math.pi, n), rng.uniform(0.05, 1.2 * w * RES, n)
 
 
-def assert_matches_traversal(result, occupied, res, origin, xy, angles, rmax, owners=None, robot_grid=None):
-    """Every ray: same hit cell, range within 1e-9 m, and the right robot reported."""
+def assert_matches_traversal(result, occupied, res, origin, xy, angles, rmax, owners=None, robot_grid=None,
+                             blocks=None):
+    """Every ray: Stage's hit cell, range within 1e-9 m, and the right robot reported. ``blocks``: cells
+    that make regions non-empty (default: the static and the robot cells)."""
     rmax = np.broadcast_to(rmax, angles.shape)
+    if blocks is None:
+        blocks = occupied if robot_grid is None else occupied | (robot_grid != -1)
     for i in range(angles.size):
-        occ_fn = occupied
+        occ = occupied
         if robot_grid is not None:
-            own = owners[i]
-
-            class _Occ:
-                grid_shape = occupied.shape
-
-                def __call__(self, rc, own=own):
-                    rid = robot_grid[rc]
-                    return occupied[rc] or (rid != -1 and rid != own)
-
-            occ_fn = _Occ()
-        want_range, want_cell = traverse(occ_fn, res, origin, xy[i, 0], xy[i, 1], angles[i], rmax[i])
+            occ = occupied | ((robot_grid != -1) & (robot_grid != owners[i]))
+        want_range, want_cell = stage_walk(occ, res, origin, xy[i, 0], xy[i, 1], angles[i], rmax[i], blocks)
         assert result.hit_cell[i] == want_cell, f"ray {i}: cell {result.hit_cell[i]} != {want_cell}"
         assert abs(result.ranges[i] - want_range) < 1e-9, f"ray {i}: {result.ranges[i]} != {want_range}"
         if robot_grid is not None:
@@ -144,7 +89,7 @@ def assert_matches_traversal(result, occupied, res, origin, xy, angles, rmax, ow
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_random_rays_match_the_traversal_cell_for_cell(seed, new_caster):
+def test_random_rays_match_stages_walk_cell_for_cell(seed, new_caster):
     rng = np.random.default_rng(seed)
     occ = random_map(rng)
     caster = new_caster(occ, RES, ORIGIN)
@@ -169,26 +114,6 @@ def test_small_and_large_batches_agree(new_caster):
     assert_matches_traversal(sub, occ, RES, ORIGIN, xy[pick], angles[pick], rmax[pick])
 
 
-def test_brute_force_sampling_agrees_except_on_provably_skipped_corners(new_caster):
-    rng = np.random.default_rng(5)
-    occ = random_map(rng)
-    caster = new_caster(occ, RES, ORIGIN)
-    xy, angles, rmax = random_rays(rng, occ, 400, margin=0.0)
-    result = caster.cast(xy, angles, rmax)
-    skipped = 0
-    for i in range(angles.size):
-        want, cell, clipped = sample(occ, RES, ORIGIN, xy[i, 0], xy[i, 1], angles[i], rmax[i], RES / 64)
-        if clipped:
-            skipped += 1
-            continue
-        if cell == -1:
-            assert result.hit_cell[i] == -1 and result.ranges[i] == rmax[i]
-            continue
-        assert result.hit_cell[i] == cell, f"ray {i}"
-        assert abs(result.ranges[i] - want) < 1e-6, f"ray {i}: {result.ranges[i]} vs {want}"
-    assert skipped <= angles.size // 50, f"{skipped} corner-clipped rays"
-
-
 def test_rays_along_grid_lines_in_all_four_directions(new_caster):
     occ = np.zeros((20, 20), dtype=bool)
     occ[:, 15] = occ[:, 3] = True  # walls at columns 3 and 15
@@ -198,11 +123,10 @@ def test_rays_along_grid_lines_in_all_four_directions(new_caster):
     xy = np.array([[8.0, 9.0]] * 4 + [[8.5, 9.5]] * 4)
     angles = np.array([0.0, math.pi / 2, math.pi, -math.pi / 2] * 2)
     result = caster.cast(xy, angles, 50.0)
-    assert result.ranges[0] == 7.0 and result.hit_cell[0] == 9 * 20 + 15
-    assert result.ranges[1] == pytest.approx(6.0, abs=1e-12) and result.hit_cell[1] == 15 * 20 + 8
-    assert result.ranges[2] == pytest.approx(4.0, abs=1e-12) and result.hit_cell[2] == 9 * 20 + 3
-    assert result.ranges[3] == pytest.approx(6.0, abs=1e-12) and result.hit_cell[3] == 2 * 20 + 8
-    assert result.ranges[4:] == pytest.approx([6.5, 5.5, 4.5, 6.5], abs=1e-12)
+    # Stage counts whole cells walked from the origin: towards -x / -y that is one cell more than the true
+    # ray's distance to the wall's near face, and an origin inside a cell walks the same whole cells.
+    assert result.ranges.tolist() == [7.0, 6.0, 5.0, 7.0] * 2
+    assert result.hit_cell.tolist() == [9 * 20 + 15, 15 * 20 + 8, 9 * 20 + 3, 2 * 20 + 8] * 2
     assert_matches_traversal(result, occ, 1.0, (0.0, 0.0), xy, angles, 50.0)
 
 
@@ -242,7 +166,10 @@ def test_misses_return_the_max_range_exactly(new_caster):
     result = caster.cast([[0.5, 0.55], [0.5, 0.55], [0.5, 0.55], [0.5, 0.55]], [0.0, math.pi, 2.0, 0.0], rmax)
     np.testing.assert_array_equal(result.ranges, rmax)
     np.testing.assert_array_equal(result.hit_cell, [-1, -1, -1, -1])
-    assert caster.cast([[0.5, 0.55]], [0.0], 0.41).ranges[0] == pytest.approx(0.4, abs=1e-12)
+    # Stage's walk takes int(range / resolution) steps and does not look at the cell its last step reaches:
+    # the wall 4 cells away is seen with a range of 5 cells, not with 4.1.
+    assert caster.cast([[0.5, 0.55]], [0.0], 0.41).ranges[0] == 0.41
+    assert caster.cast([[0.5, 0.55]], [0.0], 0.5).ranges[0] == pytest.approx(0.4, abs=1e-12)
 
 
 def test_origins_outside_the_grid_enter_it(new_caster):
@@ -250,7 +177,7 @@ def test_origins_outside_the_grid_enter_it(new_caster):
     occ[:, 5] = True
     caster = new_caster(occ, 1.0, (0.0, 0.0))
     result = caster.cast([[-3.5, 2.5], [12.0, 7.2], [-3.0, -3.0]], [0.0, math.pi, math.pi / 4], 20.0)
-    assert result.ranges[:2] == pytest.approx([8.5, 6.0], abs=1e-12)
+    assert result.ranges[:2] == pytest.approx([8.5, 7.0], abs=1e-12)  # Stage: to the far side from +x
     assert_matches_traversal(
         result,
         occ,
@@ -284,8 +211,9 @@ def test_two_heights_see_their_own_layers(new_caster):
     casters = {0.1: new_caster(low, 0.1, (0.0, 0.0)), 0.3: new_caster(high, 0.1, (0.0, 0.0))}
     xy = np.array([[0.25, 1.05]] * 2)
     ranges = {z: c.cast(xy, [0.0, 0.0], 5.0).ranges[0] for z, c in casters.items()}
-    assert ranges[0.1] == pytest.approx(0.55, abs=1e-12)
-    assert ranges[0.3] == pytest.approx(1.15, abs=1e-12)
+    # Whole cells walked from x = 2.5 cells (Stage's range; the true ray meets the faces 0.05 m sooner).
+    assert ranges[0.1] == pytest.approx(0.6, abs=1e-12)
+    assert ranges[0.3] == pytest.approx(1.2, abs=1e-12)
 
 
 def _robot_world(new_caster):
@@ -312,7 +240,7 @@ def test_robot_layer_hits_other_robots_and_passes_through_its_own(new_caster):
     result = caster.cast(xy, angles, 10.0, owners=owners, robots=layer)
     assert result.hit_robot.tolist() == [1, 0, 3, -1]
     assert result.ranges[0] == pytest.approx(1.6 - 0.2 - 0.6, abs=1e-9)  # robot 1's near face
-    assert result.ranges[3] == pytest.approx(0.6 - 0.05, abs=1e-9)  # through itself to the wall
+    assert result.ranges[3] == pytest.approx(0.6, abs=1e-9)  # through itself to the wall (its far side: Stage)
     grid = np.full(occ.shape, -1)
     grid[rows, cols] = ids
     assert_matches_traversal(result, occ, 0.05, (0.0, 0.0), xy, angles, 10.0, owners, grid)
@@ -337,7 +265,9 @@ def test_robot_layer_invisible_robots_shared_cells_and_random_rays(new_caster):
     xy = centres[owners] + rng.normal(0, 0.05, (n, 2))
     angles = rng.uniform(-math.pi, math.pi, n)
     result = caster.cast(xy, angles, 4.0, owners=owners, robots=layer)
-    assert_matches_traversal(result, occ, 0.05, (0.0, 0.0), xy, angles, 4.0, owners, grid)
+    blocks = occ.copy()
+    blocks[rows, cols] = True  # invisible robots' blocks count for the regions too
+    assert_matches_traversal(result, occ, 0.05, (0.0, 0.0), xy, angles, 4.0, owners, grid, blocks)
     assert not np.any(result.hit_robot == 1)  # invisible at this height
     assert np.any(result.hit_robot == SEVERAL_ROBOTS)
     # Moving robots: the next update replaces the old footprints completely.
