@@ -13,6 +13,7 @@ from typing import Any
 
 from stage_sim.cli.arguments import resolve_world
 from stage_sim.maps.body_geometry import global_poses
+from stage_sim.maps.raster import static_outline_summary
 from stage_sim.worldfile.description import Model, Pose, WorldDescription
 from stage_sim.worldfile.loader import load_world
 
@@ -90,9 +91,7 @@ def inspect_data(description: WorldDescription) -> dict[str, Any]:
         "rangers": rangers,
         "models": sum(1 for _ in description.walk()),
     }
-    static = static_summary(description)
-    if static is not None:
-        data["static"] = static
+    data["static"] = static_summary(description)
     data["warnings"] = [
         {
             "message": w.message,
@@ -105,15 +104,9 @@ def inspect_data(description: WorldDescription) -> dict[str, Any]:
     return data
 
 
-def static_summary(description: WorldDescription) -> dict[str, Any] | None:
-    """Obstacle extent and occupied-cell count of the static world (None until world_raster exists)."""
-    try:
-        from stage_sim.maps.raster import build_static_raster
-    except ImportError:
-        return None
-    raster = build_static_raster(description)
-    extent = raster.obstacle_extent()
-    return {"occupied_cells": raster.occupied_cell_count, "extent": list(extent) if extent else None}
+def static_summary(description: WorldDescription) -> dict[str, Any]:
+    """Static models, polygons and their extent, from the outlines alone: inspect never rasterises."""
+    return static_outline_summary(description)
 
 
 def format_inspect(data: dict[str, Any]) -> str:
@@ -150,10 +143,9 @@ def format_inspect(data: dict[str, Any]) -> str:
                 f"    sensor {k}: samples {s['samples']}  fov {s['fov']:.6g} rad  range "
                 f"[{s['range_min']:g} {s['range_max']:g}] m  pose {_pose_text(s['pose'])}"
             )
-    if "static" in data:
-        static = data["static"]
-        extent = "none" if static["extent"] is None else _list(static["extent"]) + " m"
-        lines.append(f"static world: {static['occupied_cells']} occupied cells, extent {extent}")
+    static = data["static"]
+    extent = "none" if static["extent"] is None else _list(static["extent"]) + " m"
+    lines.append(f"static world: {static['models']} models, {static['polygons']} polygons, extent {extent}")
     lines.append(f"warnings: {len(data['warnings'])}")
     for w in data["warnings"]:
         where = f"{w['file']}:{w['line']}:{w['column']}: " if w["file"] else ""

@@ -154,6 +154,18 @@ def build_static_raster(
     return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
 
 
+def static_outline_summary(description: WorldDescription) -> dict[str, object]:
+    """Static models, their polygons and the extent those cover, from geometry alone (no raster is built).
+
+    What ``stage_sim inspect`` reports: a world of any size and resolution is summarised in the time its
+    outlines take to trace, never in memory proportional to its area."""
+    shapes = _world_shapes(description)
+    points = np.concatenate([part.points for part in shapes]) if shapes else np.zeros((0, 2))
+    extent = [*points.min(axis=0), *points.max(axis=0)] if len(points) else None
+    models = len({id(part.model) for part in shapes})
+    return {"models": models, "polygons": len(shapes), "extent": [float(v) for v in extent] if extent else None}
+
+
 @dataclass(frozen=True)
 class _Placed:
     """One polygon of a static model in world coordinates, with its global z band and shape group."""

@@ -40,8 +40,8 @@ def test_json_report_of_rooms(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert sensor["samples"] == 240 and sensor["fov"] == pytest.approx(240 * math.pi / 180)
     assert (sensor["range_min"], sensor["range_max"]) == (0.0, 5.6)
     assert data["models"] == 3 and data["warnings"] == []
-    if "static" in data:  # present once stage_sim.maps.raster exists
-        assert data["static"]["occupied_cells"] > 0 and len(data["static"]["extent"]) == 4
+    assert data["static"]["models"] > 0 and data["static"]["polygons"] >= data["static"]["models"]
+    assert len(data["static"]["extent"]) == 4
 
 
 def test_json_report_lists_warnings_with_locations(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -56,10 +56,11 @@ def worlds() -> list[World]:
     return found
 
 
-def params(loading_only: bool = False, waiting: dict[str, str] | None = None) -> list:
+def params(loading_only: bool = False, waiting: dict[str, str] | None = None, rasterises: bool = True) -> list:
     """pytest params, the worlds that wait for #14 (and those in ``waiting``) marked strict xfail with the
-    reason; ``loading_only`` drops the worlds that are expected to fail to load."""
-    waits = {**NEEDS_SPARSE_WORLD, **(waiting or {})}
+    reason; ``loading_only`` drops the worlds that are expected to fail to load; a test that does not
+    rasterise (``inspect``) does not wait for the sparse world."""
+    waits = {**(NEEDS_SPARSE_WORLD if rasterises else {}), **(waiting or {})}
     chosen = []
     for world in worlds():
         if loading_only and world.id in FAILS_TO_LOAD:
