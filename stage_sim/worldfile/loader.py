@@ -8,8 +8,9 @@ models). Model names default to Stage's tokens ``type:k`` / ``parent.type:k``.
 Where Stage 4 would silently misread or refuse a world, this loader reads it the way its author meant
 and says so in a warning: Stage 3 ``laser`` and ``wifi`` models, ``size3``/``origin3``, 3-element poses,
 2-element sizes, and a ranger that has ``range``/``fov``/``samples``/``noise`` on the ranger itself but no
-``sensor( )`` block (Stage 4 ignores those keys; here they become the ranger's single sensor). Keys Stage 4 ignores (``range_max``
-inside a ranger, ``laser_return``, ``interval_real`` ...) stay ignored, with a warning. Any error raises
+``sensor( )`` block (Stage 4 ignores those keys; here they become the ranger's single sensor). Keys Stage 4
+ignores (``range_max`` inside a ranger, ``laser_return``, ``interval_real`` ...) stay ignored, with a warning.
+Any error raises
 :class:`WorldError`; nothing half-loaded is returned.
 """
 
