@@ -23,7 +23,7 @@ from stage_sim.sensing import traversal
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, visible_cells
-from stage_sim.sensing.stage_walk import WalkGrid, beam_cos_sin
+from stage_sim.sensing.stage_walk import WalkGrid, beam_cos_sin, ray_arguments
 
 
 class RobotCells:
@@ -120,11 +120,8 @@ class NumbaRayCaster:
         robots: RobotCells | None = None,
     ) -> CastResult:
         """Cast N rays; ``owners[i]`` is the robot that ray i belongs to (−1: none)."""
-        xy = np.asarray(origins_xy, dtype=np.float64).reshape(-1, 2)
+        xy, ang, rmax, own = ray_arguments(origins_xy, angles, max_ranges, owners)
         n = xy.shape[0]
-        ang = np.broadcast_to(np.asarray(angles, dtype=np.float64), (n,))
-        rmax = np.broadcast_to(np.asarray(max_ranges, dtype=np.float64), (n,))
-        own = np.ascontiguousarray(np.broadcast_to(np.asarray(-1 if owners is None else owners, dtype=np.int64), (n,)))
         cosa, sina = beam_cos_sin(ang)
         active = robots is not None and robots.active
         layer = robots if active else self._no_robots

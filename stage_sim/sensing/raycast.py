@@ -37,7 +37,7 @@ import numpy as np
 
 from stage_sim.sensing.distance_field import SQUARE_CAP, quadrant_square_fields
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import REGION, REGION_BITS, WalkGrid, WalkRays, finish_ranges
+from stage_sim.sensing.stage_walk import REGION, REGION_BITS, WalkGrid, WalkRays, finish_ranges, ray_arguments
 
 # Rows of the integer state.
 _ID, _KX, _KY, _E, _N, _SX, _SY, _BX, _BY, _Q, _IN, _CX, _CY, _R, _C, _CALC, _OWN, _XMAJ = range(18)
@@ -105,11 +105,8 @@ class GridRayCaster:
         robots: RobotLayer | None = None,
     ) -> CastResult:
         """Cast N rays; ``owners[i]`` is the robot that ray i belongs to (−1: none)."""
-        xy = np.asarray(origins_xy, dtype=np.float64).reshape(-1, 2)
+        xy, ang, rmax, own = ray_arguments(origins_xy, angles, max_ranges, owners)
         n = xy.shape[0]
-        ang = np.broadcast_to(np.asarray(angles, dtype=np.float64), (n,))
-        rmax = np.broadcast_to(np.asarray(max_ranges, dtype=np.float64), (n,))
-        own = np.broadcast_to(np.asarray(-1 if owners is None else owners, dtype=np.int64), (n,))
         rays = WalkRays.build(xy, ang, rmax, self.resolution)
         walked = np.full(n, np.inf)
         cell = np.full(n, -1, dtype=np.int64)

@@ -98,6 +98,19 @@ class WalkRays:
                    sina / cosa, reach * cosa, reach * sina, ppm)
 
 
+def ray_arguments(
+    origins_xy: np.ndarray, angles: np.ndarray, max_ranges: np.ndarray | float, owners: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A cast's arguments as both casters take them: (N, 2) origins, then angles, ranges and owners
+    broadcast to N (owners −1 when not given), so that the two kernels read identical inputs."""
+    xy = np.asarray(origins_xy, dtype=np.float64).reshape(-1, 2)
+    n = xy.shape[0]
+    ang = np.broadcast_to(np.asarray(angles, dtype=np.float64), (n,))
+    rmax = np.broadcast_to(np.asarray(max_ranges, dtype=np.float64), (n,))
+    own = np.ascontiguousarray(np.broadcast_to(np.asarray(-1 if owners is None else owners, dtype=np.int64), (n,)))
+    return xy, ang, rmax, own
+
+
 def beam_cos_sin(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """cos and sin of the beam angles, an angle of exactly 0 turned into :data:`ZERO_ANGLE` as Stage does."""
     angle = np.where(angles == 0.0, ZERO_ANGLE, angles)
