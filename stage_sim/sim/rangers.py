@@ -42,6 +42,10 @@ class _HeightGroup:
     """The rays cast at one height, with the static layer and the robots visible there."""
 
     rays: np.ndarray
+    owner: np.ndarray  #: per ray of the group: its robot, ranger, angle in the robot frame and range
+    ranger: np.ndarray
+    angle: np.ndarray
+    max_range: np.ndarray
     caster: GridRayCaster | NumbaRayCaster
     robots: RobotLayer | RobotCells
     intensity: np.ndarray
@@ -77,6 +81,9 @@ class RangerSensing:
         self._increment = np.array([r.sensor.fov / max(r.sensor.samples - 1, 1) for _, r in self._rangers])
         self._noise = np.array([r.sensor.noise for _, r in self._rangers]).reshape(-1, 3)
         self._interval_us = np.array([round(r.update_interval * 1e6) for _, r in self._rangers], dtype=np.int64)
+        self._ray_noise = self._noise[self._ranger_of_ray]
+        self._noisy = bool(np.any(self._noise != 0.0))
+        self._angle_noisy = bool(np.any(self._noise[:, 2] != 0.0))
         ray_height = np.concatenate(heights) if heights else np.zeros(0)
         self._groups = self._height_groups(robots, static, ray_height, kernels, threads)
         self._slices = self._ranger_slices()
@@ -89,6 +96,14 @@ class RangerSensing:
         """Use ``rng`` for the noise from now on."""
         self._rng = rng
 
+    def adopt(self, previous: RangerSensing) -> None:
+        """Carry on where ``previous`` (the same rangers on other kernels) stands: its latest scans, schedule,
+        pending re-scan and random generator."""
+        self.latest = previous.latest
+        self._last_us = previous._last_us.copy()
+        self._stale = previous._stale
+        self._rng = previous._rng
+
     def invalidate(self) -> None:
         """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
         self._stale = True
@@ -96,22 +111,25 @@ class RangerSensing:
     def sense(self, poses: np.ndarray, time: float) -> None:
         """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``."""
         now_us = round(time * 1e6)
-        due = np.full(len(self._rangers), self._stale) | ((now_us - self._last_us) >= self._interval_us)
+        due = ((now_us - self._last_us) >= self._interval_us) | self._stale
         self._stale = False
-        if not due.any():
+        all_due = bool(due.all())
+        if not all_due and not due.any():
             return
         self._last_us[due] = now_us
-        ray_due = due[self._ranger_of_ray]
+        ray_due = None if all_due else due[self._ranger_of_ray]
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
         robot_cells = self._bodies.point_cells(poses, self._grid) if self._bodies.count else None
-        jitter = self._angle_jitter(ray_due)
+        jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
+        origins = place(self._ranger_offset, poses[self._ranger_owner])
         for group in self._groups:
-            rays = group.rays[ray_due[group.rays]]
-            if rays.size:
-                self._cast(group, rays, poses, jitter, robot_cells, ranges, intensity)
-        noisy = self._apply_noise(ranges, ray_due)
+            chosen = None if ray_due is None else np.flatnonzero(ray_due[group.rays])
+            if chosen is None or chosen.size:
+                self._cast(group, chosen, poses, origins, jitter, robot_cells, ranges, intensity)
+        noisy = self._apply_noise(ranges, due[self._ranger_of_ray] if ray_due is None else ray_due) \
+            if self._noisy else ranges
         for k in np.flatnonzero(due):
             robot_index, ranger = self._rangers[k]
             part = self._slices[k]
@@ -123,13 +141,18 @@ class RangerSensing:
                 robot_scans.append(scan)
 
     def _cast(
-        self, group: _HeightGroup, rays: np.ndarray, poses: np.ndarray, jitter: np.ndarray,
-        robot_cells: np.ndarray | None, ranges: np.ndarray, intensity: np.ndarray,
+        self, group: _HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
+        jitter: np.ndarray | None, robot_cells: np.ndarray | None, ranges: np.ndarray, intensity: np.ndarray,
     ) -> None:
-        owner = self._owner[rays]
-        pose = poses[owner]
-        origins = place(self._ranger_offset, poses[self._ranger_owner])[self._ranger_of_ray[rays]]
-        angles = pose[:, 2] + self._angle[rays] + jitter[rays]
+        """Cast the group's rays (those at ``chosen`` positions of it; all when None) from the rangers'
+        ``origins`` and write their ranges and intensities."""
+        owner, ranger, angle, max_range, rays = group.owner, group.ranger, group.angle, group.max_range, group.rays
+        if chosen is not None:
+            owner, ranger, angle, max_range, rays = (
+                owner[chosen], ranger[chosen], angle[chosen], max_range[chosen], rays[chosen])
+        angles = poses[owner, 2] + angle
+        if jitter is not None:
+            angles = angles + jitter[rays]
         layer = None
         if robot_cells is not None:
             width = self._grid.shape[1]
@@ -138,7 +161,7 @@ class RangerSensing:
             else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
                 group.robots.mark_regions(robot_cells // width, robot_cells % width)
             layer = group.robots
-        result = group.caster.cast(origins, angles, self._max_range[rays], owners=owner, robots=layer)
+        result = group.caster.cast(origins[ranger], angles, max_range, owners=owner, robots=layer)
         ranges[rays] = result.ranges
         static_hit = result.hit_cell >= 0
         hits = np.zeros(len(rays), dtype=np.float32)
@@ -149,11 +172,12 @@ class RangerSensing:
         hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
         intensity[rays] = hits
 
-    def _angle_jitter(self, ray_due: np.ndarray) -> np.ndarray:
-        """Stage's beam-direction noise inc·a·U/2 for due beams of rangers with an angle noise, else 0."""
+    def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
+        """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle
+        noise, else 0."""
         jitter = np.zeros(len(self._owner))
-        angle_noise = self._noise[self._ranger_of_ray, 2]
-        rays = np.flatnonzero(ray_due & (angle_noise != 0.0))
+        angle_noise = self._ray_noise[:, 2]
+        rays = np.flatnonzero((angle_noise != 0.0) if ray_due is None else ray_due & (angle_noise != 0.0))
         if rays.size:
             scale = self._increment[self._ranger_of_ray[rays]] * angle_noise[rays] / 2
             jitter[rays] = scale * self._rng.uniform(-1.0, 1.0, len(rays))
@@ -161,7 +185,7 @@ class RangerSensing:
 
     def _apply_noise(self, ranges: np.ndarray, ray_due: np.ndarray) -> np.ndarray:
         """Stage's per-beam noise for rangers that have some; other beams pass unchanged."""
-        noise = self._noise[self._ranger_of_ray]
+        noise = self._ray_noise
         noisy_ray = ray_due & np.any(noise != 0.0, axis=1)
         if not noisy_ray.any():
             return ranges
@@ -183,8 +207,13 @@ class RangerSensing:
             occupied, intensity = static.sensing_layer(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
             caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads, static.blocks)
+            rays = np.flatnonzero(ray_height == height)
             groups.append(_HeightGroup(
-                rays=np.flatnonzero(ray_height == height),
+                rays=rays,
+                owner=self._owner[rays],
+                ranger=self._ranger_of_ray[rays],
+                angle=self._angle[rays],
+                max_range=self._max_range[rays],
                 caster=caster,
                 robots=caster.robot_layer(),
                 intensity=intensity,

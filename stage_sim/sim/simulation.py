@@ -17,6 +17,7 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import dataclass
+from importlib import import_module
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ import numpy as np
 from stage_sim.maps.raster import StaticRaster, build_static_raster
 from stage_sim.sensing.kernels import resolve_kernels, resolve_threads
 from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
+from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, mark_numba_loaded, upgrade_wanted
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import draw_odom_errors, integrate_odometry, relative_pose
 from stage_sim.sim.rangers import RangerSensing, Scan
@@ -55,7 +57,9 @@ class Simulation:
         ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
         ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.sensing.kernels`."""
         self.description = description
-        self.kernels = resolve_kernels(kernels)
+        # Nobody chose: step on numpy until numba is loaded in the background (sim/kernel_upgrade.py).
+        self._upgrade = KernelUpgrade(self) if upgrade_wanted(kernels) else None
+        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(kernels)
         self.threads = resolve_threads(threads)
         self.warnings: list[WorldWarning] = list(description.warnings)
         self.robots: list[RobotSpec] = build_robots(description, self.warnings)
@@ -63,10 +67,12 @@ class Simulation:
         self.watchdog_timeout = watchdog_timeout
         starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
         self.static: StaticRaster = build_static_raster(description, starts)
-        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.kernels)
         self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
-        self._collision = self._make_collision_checker(grid)
-        self._sensing = RangerSensing(self.robots, self.static, self._bodies, grid, self.kernels, self.threads)
+        self._collision, self._sensing = self.build_parts(self.kernels)
+        # numba is imported only when the compiled kernels run (the numpy path must work without it)
+        self._motion = import_module("stage_sim.sim.motion_kernels") if self.kernels == "numba" else None
+        if self.kernels == "numba":
+            mark_numba_loaded()
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
         self._drives = np.array([r.drive_code for r in self.robots], dtype=np.int64)
@@ -152,14 +158,51 @@ class Simulation:
         if self.watchdog_timeout > 0:
             silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
             self.commands[silent] = 0.0
-        self.velocities = body_velocity(self.commands, self._drives, self._wheelbases, self._bounds)
+        self.velocities = self._body_velocities()
         moved, refused = self._collision.resolve(self.true_poses, self.velocities, dt)
         moving = np.any(self.velocities != 0.0, axis=1)
         self.stalled = np.where(moving, refused, self.stalled)
         self.true_poses = moved
-        odom = integrate_odometry(self.odometry_poses, self.velocities, self.odom_errors, dt)
-        self.odometry_poses = np.where(self._uses_odom[:, None], odom, moved)
+        self.odometry_poses = self._odometry(moved, dt)
         self._sensing.sense(self.true_poses, self.sim_time)
+        if self._upgrade is not None:
+            self._adopt(self._upgrade.poll())
+
+    def wait_for_kernels(self, timeout: float | None = None) -> None:
+        """Block until a background switch to the compiled kernels (if any is under way) is ready; the
+        switch itself happens at the end of the next step. For benchmarks that must time one implementation."""
+        if self._upgrade is not None:
+            self._upgrade.wait(timeout)
+
+    def _adopt(self, parts: CompiledParts | None) -> None:
+        """Continue on the compiled parts: the new sensing takes over the scans, schedule and noise state."""
+        if parts is None:
+            return
+        parts.sensing.adopt(self._sensing)
+        self._collision, self._sensing, self._motion = parts.collision, parts.sensing, parts.motion
+        self.kernels = "numba"
+        self._upgrade = None
+
+    def _body_velocities(self) -> np.ndarray:
+        """The body velocities the commands give (:func:`body_velocity`; one compiled pass with numba)."""
+        if self._motion is None:
+            return body_velocity(self.commands, self._drives, self._wheelbases, self._bounds)
+        steer = self.commands[:, 2]
+        out = np.empty_like(self.commands)
+        self._motion.body_velocities(self.commands, self._drives, self._wheelbases, self._bounds, np.cos(steer),
+                                     np.sin(steer), out)
+        return out
+
+    def _odometry(self, moved: np.ndarray, dt: float) -> np.ndarray:
+        """Odometry after the step: integrated with the odom errors, or the true pose (gps localization)."""
+        if self._motion is None:
+            odom = integrate_odometry(self.odometry_poses, self.velocities, self.odom_errors, dt)
+            return np.where(self._uses_odom[:, None], odom, moved)
+        heading = self.odometry_poses[:, 2]
+        out = np.empty_like(moved)
+        self._motion.integrate_estimates(self.odometry_poses, self.velocities, self.odom_errors, dt,
+                                         np.cos(heading), np.sin(heading), self._uses_odom, moved, out)
+        return out
 
     # -- queries ---------------------------------------------------------------------------------------
 
@@ -167,6 +210,11 @@ class Simulation:
     def sim_time(self) -> float:
         """Simulated seconds since the start (or the last :meth:`reset`)."""
         return self.sim_time_us / MICROSECONDS
+
+    @property
+    def start_poses(self) -> np.ndarray:
+        """The robots' start poses (N, 3), where :meth:`reset_positions` puts them."""
+        return self._start.copy()
 
     @property
     def interval(self) -> float:
@@ -186,6 +234,12 @@ class Simulation:
         )
 
     # -- construction helpers --------------------------------------------------------------------------
+
+    def build_parts(self, kernels: str) -> tuple[CollisionChecker, RangerSensing]:
+        """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used)."""
+        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, kernels)
+        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, kernels, self.threads)
+        return self._make_collision_checker(grid), sensing
 
     def _make_collision_checker(self, grid: GridFrame) -> CollisionChecker:
         bands = sorted({r.z_band for r in self.robots})

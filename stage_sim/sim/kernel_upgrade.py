@@ -1,0 +1,115 @@
+"""Start on the numpy kernels, switch to numba when it is ready: the first scan does not wait for numba.
+
+Importing numba and loading even cached kernels costs a process 1.5-2.5 s on the project's machines, longer
+than everything else stageros does before its first scan. Both implementations give identical answers bit
+for bit (``tests/sim/test_kernel_identity.py``), so a simulation whose kernels were not chosen explicitly
+steps on the numpy reference at first while one background thread imports numba and builds the compiled
+collision checker and ray casters; between two steps the simulation adopts them. Nothing a user observes
+changes except speed (and :attr:`Simulation.kernels`, which says which implementation runs now).
+
+The upgrade is used only when nobody chose: no ``kernels`` argument, no ``$STAGE_SIM_KERNELS``, and numba's
+kernels not yet loaded in this process (a second simulation gets them at once).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
+from importlib import import_module
+from types import ModuleType
+from typing import Any, Protocol
+
+import numpy as np
+
+from stage_sim.sensing.kernels import KERNELS_ENV, numba_available
+
+log = logging.getLogger("stage_sim")
+_LOADED = {"numba": False}
+
+
+def numba_loaded() -> bool:
+    """Whether some simulation of this process already runs the compiled kernels."""
+    return _LOADED["numba"]
+
+
+def mark_numba_loaded() -> None:
+    """Record that the compiled kernels are loaded (later simulations use them from the start)."""
+    _LOADED["numba"] = True
+
+
+def upgrade_wanted(kernels: str | None) -> bool:
+    """True when nobody chose the kernels and numba's are not loaded yet: start on numpy, upgrade later."""
+    return kernels is None and not os.environ.get(KERNELS_ENV) and not numba_loaded()
+
+
+class Upgradable(Protocol):
+    """What the upgrade needs of a simulation (:class:`~stage_sim.sim.simulation.Simulation`)."""
+
+    robots: list
+    start_poses: np.ndarray
+
+    def build_parts(self, kernels: str) -> tuple[Any, Any]: ...
+
+
+@dataclass(frozen=True)
+class CompiledParts:
+    """What a simulation swaps in: the compiled collision checker, ray sensing and motion kernels."""
+
+    collision: Any
+    sensing: Any
+    motion: ModuleType
+
+
+class KernelUpgrade:
+    """Builds a simulation's compiled parts on one background thread, started after its first step."""
+
+    def __init__(self, sim: Upgradable) -> None:
+        self._sim = sim
+        self._future: Future | None = None
+        self._adopted = False
+        self._started = 0.0
+
+    def poll(self) -> CompiledParts | None:
+        """Call after each step: starts the build the first time, returns the parts once (when built).
+
+        A build that fails (numba missing or broken) leaves the simulation on numpy for good."""
+        if self._future is None:
+            self._started = time.monotonic()
+            pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="stage_sim-kernels")
+            self._future = pool.submit(build_compiled_parts, self._sim)
+            pool.shutdown(wait=False)  # the one job runs on; the thread ends with it
+            return None
+        if self._adopted or not self._future.done():
+            return None
+        self._adopted = True
+        try:
+            parts = self._future.result()
+        except Exception as error:  # a kernel that cannot load must not stop a running simulation
+            log.warning("compiled kernels unavailable (%s); staying on the numpy kernels", error)
+            return None
+        if parts is not None:
+            log.info("simulation kernels: numba (ready %.1f s after the first step)", time.monotonic() - self._started)
+        return parts
+
+    def wait(self, timeout: float | None = None) -> None:
+        """Block until the background build (if started) has finished; for tests and benchmarks."""
+        if self._future is not None:
+            self._future.exception(timeout)
+
+
+def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
+    """The compiled collision checker, sensing and motion kernels for ``sim``, each run once so that the
+    main thread never waits for numba's loading; None when numba is unavailable."""
+    if not numba_available():
+        return None
+    collision, sensing = sim.build_parts("numba")
+    motion = import_module("stage_sim.sim.motion_kernels")
+    motion.warm(len(sim.robots))
+    poses = sim.start_poses
+    collision.overlapping(poses)
+    sensing.sense(poses, 0.0)
+    mark_numba_loaded()
+    return CompiledParts(collision, sensing, motion)
