@@ -7,8 +7,9 @@ steps on the numpy reference at first while one background thread imports numba 
 collision checker and ray casters; between two steps the simulation adopts them. Nothing a user observes
 changes except speed (and :attr:`Simulation.kernels`, which says which implementation runs now).
 
-The upgrade is used only when nobody chose: no ``kernels`` argument, no ``$STAGE_SIM_KERNELS``, and numba's
-kernels not yet loaded in this process (a second simulation gets them at once).
+The upgrade is used only when nobody chose: no ``kernels`` argument, no ``$STAGE_SIM_KERNELS``, numba's
+kernels not yet loaded in this process (a second simulation gets them at once), and a world with at most
+:data:`MAX_NUMPY_BEAMS` laser beams (a swarm or a 1081-beam crowd would crawl on numpy meanwhile).
 """
 
 from __future__ import annotations
@@ -40,9 +41,15 @@ def mark_numba_loaded() -> None:
     _LOADED["numba"] = True
 
 
-def upgrade_wanted(kernels: str | None) -> bool:
-    """True when nobody chose the kernels and numba's are not loaded yet: start on numpy, upgrade later."""
-    return kernels is None and not os.environ.get(KERNELS_ENV) and not numba_loaded()
+#: Beams per step above which the numpy reference would make the first seconds slow (it walks ~0.3 M rays/s):
+#: larger worlds wait for numba before their first step instead.
+MAX_NUMPY_BEAMS = 4096
+
+
+def upgrade_wanted(kernels: str | None, beams: int) -> bool:
+    """True when nobody chose the kernels, numba's are not loaded yet and the world's ``beams`` per step are
+    few enough for the numpy reference: start on numpy, upgrade later."""
+    return kernels is None and not os.environ.get(KERNELS_ENV) and not numba_loaded() and beams <= MAX_NUMPY_BEAMS
 
 
 class Upgradable(Protocol):

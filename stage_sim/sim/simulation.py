@@ -57,12 +57,13 @@ class Simulation:
         ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
         ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.sensing.kernels`."""
         self.description = description
-        # Nobody chose: step on numpy until numba is loaded in the background (sim/kernel_upgrade.py).
-        self._upgrade = KernelUpgrade(self) if upgrade_wanted(kernels) else None
-        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(kernels)
-        self.threads = resolve_threads(threads)
         self.warnings: list[WorldWarning] = list(description.warnings)
         self.robots: list[RobotSpec] = build_robots(description, self.warnings)
+        # Nobody chose: step on numpy until numba is loaded in the background (sim/kernel_upgrade.py).
+        beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
+        self._upgrade = KernelUpgrade(self) if upgrade_wanted(kernels, beams) else None
+        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(kernels)
+        self.threads = resolve_threads(threads)
         self.interval_us = max(1, round(description.settings.interval_sim * MICROSECONDS))
         self.watchdog_timeout = watchdog_timeout
         starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]

@@ -41,7 +41,7 @@ def frames(sim: Simulation, switch_at: int | None = None) -> tuple[list[tuple], 
 
 
 def test_unchosen_kernels_switch_to_numba_without_changing_the_run(numba_not_loaded):
-    world = load_world_text(crowd_world(2), "crowd.world")
+    world = load_world_text(crowd_world(2).replace("samples 271", "samples 91"), "crowd.world")
     switching = Simulation(world, seed=2)
     assert switching.kernels == "numpy"
     switched, used = frames(switching, switch_at=10)
@@ -53,10 +53,17 @@ def test_unchosen_kernels_switch_to_numba_without_changing_the_run(numba_not_loa
 
 
 def test_explicit_choices_and_loaded_kernels_start_at_once(numba_not_loaded, monkeypatch):
-    world = load_world_text(crowd_world(0), "crowd.world")
+    world = load_world_text(crowd_world(0).replace("samples 271", "samples 91"), "crowd.world")
     assert Simulation(world, kernels="numpy").kernels == "numpy"
     monkeypatch.setenv("STAGE_SIM_KERNELS", "numpy")
     assert Simulation(world).kernels == "numpy"
     monkeypatch.delenv("STAGE_SIM_KERNELS")
     assert Simulation(world, kernels="numba").kernels == "numba"
     assert Simulation(world).kernels == "numba"  # this process has loaded them now
+
+
+def test_a_world_with_many_beams_waits_for_numba(numba_not_loaded):
+    world = load_world_text(crowd_world(1), "crowd.world")  # 16 robots x 271 beams
+    assert sum(r.sensor.samples for robot in Simulation(world, kernels="numpy").robots for r in robot.rangers) > \
+        kernel_upgrade.MAX_NUMPY_BEAMS
+    assert Simulation(world).kernels == "numba"
