@@ -49,8 +49,9 @@ run: setup
 test: setup
 	$(PY) -m pytest $(PYTEST_ARGS)
 
-# Both laser cases for 1-1000 robots: numba on one core, numba on 2 threads, numpy on one core (1 and 100
-# robots, for the ratio). One configuration per process, so that each peak_rss_mb is its own.
+# Every row of issue #14's table: rays/s; both laser cases for 1-1000 robots (numba on one core, numba on 2
+# threads, numpy on one core at 1 and 100 robots, for the ratio; one configuration per process, so that each
+# peak_rss_mb is its own); stageros --speedup 0; start to first scan; the two large worlds.
 SHORT_LASER := --beams 240 --fov 240 --range 5.6
 LONG_LASER := --beams 1081 --fov 270 --range 30
 bench: setup
@@ -60,6 +61,8 @@ bench: setup
 	  $(PY) benchmarks/simulate.py $$laser --kernels numba --threads 2 --robots 1 10 100 1000 && \
 	  $(PY) benchmarks/simulate.py $$laser --kernels numpy --threads 1 --robots 1 100 || exit 1; \
 	done
+	$(PY) benchmarks/stageros.py
+	$(PY) benchmarks/startup.py
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts
