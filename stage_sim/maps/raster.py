@@ -20,12 +20,14 @@ The grid's cells are Stage's cells: its origin is a whole number of cells from t
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import groupby
 
 import numpy as np
 
 from stage_sim.maps.body_geometry import body_frame, body_shape, global_poses, transform_points
 from stage_sim.maps.polygon_raster import edge_cells, fill_cells, vertex_cells
+from stage_sim.maps.tiles import DENSE_CELL_LIMIT, CellValues, TileGrid, TileLayer, WorldTooLargeError
 from stage_sim.worldfile.description import Model, WorldDescription
 from stage_sim.worldfile.occupancy import FREE, OCCUPIED, OccupancyGrid
 
@@ -34,21 +36,39 @@ from stage_sim.worldfile.occupancy import FREE, OCCUPIED, OccupancyGrid
 class StaticBody:
     """One shape of a static model (a block, a wall, an image's outlines) and what it means to rays and robots.
 
-    ``outline`` holds the flat indices of Stage's raster cells (edges only), what rays and bodies hit;
-    ``cells`` the filled footprint (outline and inside), what a map shows.
+    ``outline`` holds the sorted flat indices of Stage's raster cells (edges only), what rays and bodies hit
+    (8 B per cell); :attr:`cells` the filled footprint (outline and inside), what a map shows, made only
+    when a map is asked for.
     """
 
     name: str
-    cells: np.ndarray
     outline: np.ndarray
     z: tuple[float, float]
     ranger_return: float
     obstacle_return: bool
+    polygons: list[np.ndarray] = field(repr=False, compare=False)
+    frame: tuple[float, tuple[float, float], tuple[int, int]] = field(repr=False, compare=False)
+    """(resolution, origin, shape) of the grid the cells index."""
+
+    @cached_property
+    def cells(self) -> np.ndarray:
+        """Sorted flat cells of the filled footprint: the outline and the cells whose centre is inside."""
+        resolution, origin, shape = self.frame
+        points = np.concatenate(self.polygons)
+        span = (points.max(axis=0) - points.min(axis=0)) / resolution + 2
+        if span[0] * span[1] > DENSE_CELL_LIMIT:
+            raise WorldTooLargeError(
+                f"the filled footprint of {self.name!r} spans {span[0]:.0f} x {span[1]:.0f} cells (the limit of a "
+                f"map is {DENSE_CELL_LIMIT / 1e6:.0f} M cells): use a coarser resolution")
+        return np.union1d(self.outline, fill_cells(self.polygons, resolution, origin, shape))
 
 
 @dataclass
 class StaticRaster:
-    """All static bodies on one grid (row 0 = smallest y, flat index = row·width + col)."""
+    """All static bodies on one virtual grid (row 0 = smallest y, flat index = row·width + col), stored in
+    tiles (:mod:`stage_sim.maps.tiles`): nothing here costs memory in proportion to the grid's area, but the
+    dense copies a picture of the whole world asks for (:meth:`sensing_layer`, :meth:`collision_layer`,
+    :attr:`occupied`, :meth:`to_occupancy_grid`), refused past :data:`~stage_sim.maps.tiles.DENSE_CELL_LIMIT`."""
 
     shape: tuple[int, int]
     resolution: float
@@ -56,34 +76,43 @@ class StaticRaster:
     bodies: list[StaticBody]
     _cache: dict = field(default_factory=dict, repr=False)
 
+    @cached_property
+    def grid(self) -> TileGrid:
+        """The tile grid: Stage's regions, a slot for each one holding a block of any body at any height."""
+        blocks = np.concatenate([body.outline for body in self.bodies] or [np.zeros(0, dtype=np.int64)])
+        return TileGrid.build(self.shape, self.resolution, self.origin_xy, blocks)
+
+    def sensing_tiles(self, height: float) -> tuple[TileLayer, CellValues]:
+        """The cells rays at ``height`` hit, in tiles, and their intensity (a later body over an earlier one)."""
+        seen = [body for body in self.bodies if body.ranger_return >= 0 and body.z[0] <= height <= body.z[1]]
+        flat = np.concatenate([body.outline for body in seen] or [np.zeros(0, dtype=np.int64)])
+        values = np.concatenate([np.full(body.outline.size, body.ranger_return) for body in seen] or [np.zeros(0)])
+        intensity = CellValues.last_wins(flat, values)
+        return TileLayer.from_cells(self.grid, intensity.cells), intensity
+
+    def collision_tiles(self, z_low: float, z_high: float) -> TileLayer:
+        """The cells that block a body spanning [z_low, z_high], in tiles."""
+        flat = [body.outline for body in self.bodies
+                if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low]
+        return TileLayer.from_cells(self.grid, np.unique(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
+
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
-        """(occupied, intensity) grids for rays at ``height``."""
-        key = ("sense", round(height, 9))
-        if key not in self._cache:
-            occupied = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
-            intensity = np.zeros(occupied.shape, dtype=np.float32)
-            for body in self.bodies:
-                if body.ranger_return >= 0 and body.z[0] <= height <= body.z[1]:
-                    occupied[body.outline] = True
-                    intensity[body.outline] = body.ranger_return
-            self._cache[key] = (occupied.reshape(self.shape), intensity.reshape(self.shape))
-        return self._cache[key]
+        """(occupied, intensity) dense grids for rays at ``height`` (a picture: small worlds only)."""
+        self.grid.check_dense("a dense sensing layer")
+        layer, intensity = self.sensing_tiles(height)
+        values = np.zeros(self.shape[0] * self.shape[1], dtype=np.float32)
+        values[intensity.cells] = intensity.values
+        return layer.dense(), values.reshape(self.shape)
 
     def collision_layer(self, z_low: float, z_high: float) -> np.ndarray:
-        """Cells that block a body spanning [z_low, z_high]."""
-        key = ("collide", round(z_low, 9), round(z_high, 9))
-        if key not in self._cache:
-            blocked = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
-            for body in self.bodies:
-                if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low:
-                    blocked[body.outline] = True
-            self._cache[key] = blocked.reshape(self.shape)
-        return self._cache[key]
+        """Dense grid of the cells that block a body spanning [z_low, z_high] (small worlds only)."""
+        return self.collision_tiles(z_low, z_high).dense("a dense collision layer")
 
     @property
     def occupied(self) -> np.ndarray:
         """Cells of any static body's filled footprint, whatever its height or flags (a map, not the raster)."""
         if "any" not in self._cache:
+            self.grid.check_dense("a map of the world")
             occupied = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
             for body in self.bodies:
                 occupied[body.cells] = True
@@ -91,28 +120,9 @@ class StaticRaster:
         return self._cache["any"]
 
     @property
-    def blocks(self) -> np.ndarray:
-        """Cells of any static body's raster, whatever its height or flags: where Stage's regions hold blocks."""
-        if "blocks" not in self._cache:
-            blocks = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
-            for body in self.bodies:
-                blocks[body.outline] = True
-            self._cache["blocks"] = blocks.reshape(self.shape)
-        return self._cache["blocks"]
-
-    @property
     def occupied_cell_count(self) -> int:
         """How many cells the filled footprints cover."""
         return int(self.occupied.sum())
-
-    def obstacle_extent(self) -> tuple[float, float, float, float] | None:
-        """World bounding box (xmin, ymin, xmax, ymax) of the occupied cells, None for an empty world."""
-        rows, cols = np.nonzero(self.occupied)
-        if rows.size == 0:
-            return None
-        x0, y0 = self.origin_xy
-        res = self.resolution
-        return (x0 + cols.min() * res, y0 + rows.min() * res, x0 + (cols.max() + 1) * res, y0 + (rows.max() + 1) * res)
 
     def to_occupancy_grid(self) -> OccupancyGrid:
         """The static world as a nav_msgs-style grid (100 occupied, 0 free) for ``/map``."""
@@ -141,16 +151,14 @@ def build_static_raster(
     shape = (int(high[1] - low[1]) + 1, int(high[0] - low[0]) + 1)
     origin = (float(low[0]) * resolution, float(low[1]) * resolution)
     bodies = []
+    frame = (resolution, origin, shape)
     for _, members in groupby(zip(shapes, outlines, strict=True), key=lambda item: (id(item[0].model), item[0].group)):
         parts = list(members)
         shape_of, cells = parts[0][0], np.concatenate([cells for _, cells in parts]) - low
-        marked = np.zeros(shape[0] * shape[1], dtype=bool)
-        marked[cells[:, 1] * shape[1] + cells[:, 0]] = True
-        outline = np.flatnonzero(marked)
-        marked[fill_cells([part.points for part, _ in parts], resolution, origin, shape)] = True
+        outline = np.unique(cells[:, 1] * shape[1] + cells[:, 0])
         model = shape_of.model
-        bodies.append(StaticBody(
-            model.name, np.flatnonzero(marked), outline, shape_of.z, model.ranger_return, model.obstacle_return))
+        bodies.append(StaticBody(model.name, outline, shape_of.z, model.ranger_return, model.obstacle_return,
+                                 [part.points for part, _ in parts], frame))
     return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
 
 

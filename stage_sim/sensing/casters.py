@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing.kernels import resolve_kernels
 from stage_sim.sensing.raycast import GridRayCaster
 
@@ -14,12 +15,14 @@ if TYPE_CHECKING:
 
 
 def make_caster(
-    occupied: np.ndarray, resolution: float, origin_xy: tuple[float, float], kernels: str | None = None,
+    occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float], kernels: str | None = None,
     threads: int = 1, blocks: np.ndarray | None = None,
 ) -> GridRayCaster | NumbaRayCaster:
     """A ray caster for one static layer, of the implementation :func:`resolve_kernels` picks.
 
-    ``blocks``: the cells of every static block at any height (Stage skips regions without one)."""
+    ``occupied``: the layer in tiles (:meth:`~stage_sim.maps.raster.StaticRaster.sensing_tiles`: its grid knows
+    the regions holding a static block at any height, which Stage's walk does not skip), or a dense (H, W)
+    grid with ``blocks``, the dense cells of every static block at any height (default: ``occupied``)."""
     if resolve_kernels(kernels) == "numba":
         from stage_sim.sensing.fast_caster import NumbaRayCaster
 

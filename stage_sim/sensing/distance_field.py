@@ -1,54 +1,48 @@
-"""Free-space certificates for the numpy ray caster (:mod:`stage_sim.sensing.raycast`).
+"""Free-space certificates for both ray casters: the largest free square ahead of a cell, within its tile.
 
-Everything here answers "how far is it certainly free from this cell?" so that the walk can cross free
-space in one vectorised step instead of visiting every cell.
+For each cell ``c`` of a tile and each of the four diagonal quadrants ``q = (sx < 0) + 2·(sy < 0)``, the
+side ``k`` of the largest free square that has ``c`` as its corner and extends towards ``(sx, sy)``
+*without leaving the tile*: the cells ``c + (sx·i, sy·j)``, ``0 <= i, j < k``, are all free and in the
+tile, and ``k = 0`` iff ``c`` is occupied. Cells beyond the tile count as occupied, so a jump through the
+square never leaves the tile (Stage's region): the walk takes the region border one step at a time and
+looks at the next region afresh. A ray moving towards that quadrant cannot leave the square before it has
+travelled ``k`` cells along one axis, wherever it starts inside ``c``.
 
-* :func:`quadrant_square_fields` – for each cell ``c`` and each of the four diagonal quadrants
-  ``(sx, sy)``, the side ``k`` of the largest free square that has ``c`` as its corner and extends
-  towards ``(sx, sy)``: the cells ``c + (sx·i, sy·j)``, ``0 <= i, j < k``, are all free, and ``k = 0``
-  iff ``c`` is occupied. A ray moving towards that quadrant cannot leave the square before it has
-  travelled ``k`` cells along one axis, wherever it starts inside ``c``. This is the chessboard
-  distance to the nearest occupied cell *ahead* of the ray, so walls behind or beside a ray never
-  slow it down. Computed by the classic "largest square" recurrence
-  ``k(c) = 1 + min(k(c+x), k(c+y), k(c+x+y))``, one row at a time (the row recurrence is a reversed
-  running minimum, so every row is a handful of numpy calls).
-
-Cells outside the array count as free.
+Computed by the classic "largest square" recurrence ``k(c) = 1 + min(k(c+x), k(c+y), k(c+x+y))``, one row
+of every tile at a time (the row recurrence is a reversed running minimum, so a row is a handful of numpy
+calls for all tiles and quadrants together). Static tiles: 32 × 32 cells, 4 KB per tile (uint8 per cell
+and quadrant); robot block tiles: 4 × 4 blocks, 64 B.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-#: Largest square side stored (uint8). A longer free stretch simply takes one more jump.
+#: Largest square side a caller may treat as "no limit" (every tile square is at most a tile side).
 SQUARE_CAP = 255
 
 
-def quadrant_square_fields(occupied: np.ndarray) -> np.ndarray:
-    """Return ``(4, H, W)`` uint8 square sides, quadrant ``q = 2·(sy < 0) + (sx < 0)``.
-
-    Quadrant ``q`` is stored *flipped* so that it always extends towards +x/+y in its own array:
-    array ``q`` is ``occupied`` mirrored in x when ``sx < 0`` and in y when ``sy < 0``. Callers that
-    work in mirrored ("oriented") coordinates can then treat every ray as moving up and right.
-    """
+def tile_square_fields(occupied: np.ndarray) -> np.ndarray:
+    """(T, 4, S, S) uint8 square sides of tiles ``occupied`` (T, S, S) bool, ``[tile, q, row, col]``."""
     occ = np.asarray(occupied, dtype=bool)
-    h, w = occ.shape
-    flipped = np.stack([occ, occ[:, ::-1], occ[::-1, :], occ[::-1, ::-1]])
-    out = np.empty((4, h, w), dtype=np.uint8)
-    col = np.arange(w + 1, dtype=np.int32)
-    # prev: side lengths of the row above (y + 1), one extra column = outside the grid (free).
-    prev = np.full((4, w + 1), SQUARE_CAP, dtype=np.int32)
-    cand = np.empty((4, w + 1), dtype=np.int32)
-    cand[:, w] = SQUARE_CAP + w
-    for y in range(h - 1, -1, -1):
+    t, s = occ.shape[0], occ.shape[1]
+    # Every quadrant turned to extend towards +x / +y: mirrored in x when sx < 0, in y when sy < 0.
+    flipped = np.stack([occ, occ[:, :, ::-1], occ[:, ::-1, :], occ[:, ::-1, ::-1]], axis=1).reshape(4 * t, s, s)
+    out = np.empty((4 * t, s, s), dtype=np.uint8)
+    col = np.arange(s + 1, dtype=np.int32)
+    # prev: sides of the row above (y + 1); one extra column, beyond the tile: occupied (side 0).
+    prev = np.zeros((4 * t, s + 1), dtype=np.int32)
+    cand = np.empty((4 * t, s + 1), dtype=np.int32)
+    cand[:, s] = s
+    for y in range(s - 1, -1, -1):
         # Free cell: k(x) = 1 + min(m(x), k(x+1)) with m(x) = min(k_above(x), k_above(x+1)); an
         # occupied cell has k = 0. Unrolled, k(x) = min_{x' >= x} cand(x') - x with
         # cand(x') = x' (occupied) or m(x') + 1 + x' (free): a reversed running minimum.
-        np.minimum(prev[:, :w], prev[:, 1:], out=cand[:, :w])
-        cand[:, :w] += col[:w] + 1
-        np.copyto(cand[:, :w], col[:w], where=flipped[:, y])
-        side = np.minimum.accumulate(cand[:, ::-1], axis=1)[:, ::-1] - col
-        np.minimum(side, SQUARE_CAP, out=side)
-        out[:, y] = side[:, :w]
-        prev = side
-    return out
+        np.minimum(prev[:, :s], prev[:, 1:], out=cand[:, :s])
+        cand[:, :s] += col[:s] + 1
+        np.copyto(cand[:, :s], col[:s], where=flipped[:, y])
+        prev = np.minimum.accumulate(cand[:, ::-1], axis=1)[:, ::-1] - col
+        out[:, y] = prev[:, :s]
+    out = out.reshape(t, 4, s, s)
+    return np.ascontiguousarray(np.stack(
+        [out[:, 0], out[:, 1, :, ::-1], out[:, 2, ::-1, :], out[:, 3, ::-1, ::-1]], axis=1))

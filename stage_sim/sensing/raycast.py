@@ -11,9 +11,11 @@ cell (0, 0) is Stage's world cell ``round(origin_xy / resolution)``. Cells outsi
 How it is fast: all rays advance together, one *action* per ray and round: a region test (and, for an
 empty region, Stage's jump to its border), or one cell of the walk. Free space inside a region holding
 blocks is crossed in one action: the walk may take any number of steps that keep it inside the largest
-free square ahead of its cell (:func:`~stage_sim.sensing.distance_field.quadrant_square_fields`), the
-square of robot-free blocks (:class:`~stage_sim.sensing.robot_layer.RobotLayer`) and the region, and
-:func:`walk_prefix` says where the walk stands after them. Finished rays leave the arrays.
+free square ahead of its cell within the region's tile
+(:func:`~stage_sim.sensing.distance_field.tile_square_fields`), the square of robot-free blocks
+(:class:`~stage_sim.sensing.robot_layer.RobotLayer`) and the region, and :func:`walk_prefix` says where the
+walk stands after them. Finished rays leave the arrays. The world is read through its tiles
+(:mod:`stage_sim.maps.tiles`): 4 KB of free squares per static tile, nothing for empty space.
 
 Usage::
 
@@ -26,7 +28,8 @@ Usage::
     result = caster.cast(origins_xy, angles, ranges, owners=ray_robot_ids, robots=robots)
 
 Build one caster per distinct ray height (its occupancy = cells of models whose z band contains the
-height and whose ``ranger_return >= 0``); casters cache their fields, so keep them.
+height and whose ``ranger_return >= 0``: :meth:`~stage_sim.maps.raster.StaticRaster.sensing_tiles`, or a
+dense grid); casters cache their fields, so keep them.
 """
 
 from __future__ import annotations
@@ -35,12 +38,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from stage_sim.sensing.distance_field import SQUARE_CAP, quadrant_square_fields
+from stage_sim.maps.tiles import TileGrid, TileLayer
+from stage_sim.sensing.distance_field import SQUARE_CAP, tile_square_fields
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import REGION, REGION_BITS, WalkGrid, WalkRays, finish_ranges, ray_arguments
+from stage_sim.sensing.stage_walk import REGION, REGION_BITS, WalkRays, finish_ranges, ray_arguments, static_layer
 
-# Rows of the integer state.
-_ID, _KX, _KY, _E, _N, _SX, _SY, _BX, _BY, _Q, _IN, _CX, _CY, _R, _C, _CALC, _OWN, _XMAJ = range(18)
+# Rows of the integer state (_TILE: static tile of the region the walk is in, _RTILE: its robot tile).
+_ID, _KX, _KY, _E, _N, _SX, _SY, _BX, _BY, _Q, _IN, _CX, _CY, _R, _C, _CALC, _OWN, _XMAJ, _TILE, _RTILE = range(20)
 # Rows of the float state.
 (_BASEX, _BASEY, _STX, _STY, _COS, _SIN, _TAN, _XCX, _XCY, _YCX, _YCY, _DSX, _DSY, _XJX, _XJY, _YJX, _YJY, _XJD,
  _YJD) = range(19)
@@ -72,29 +76,26 @@ def walk_prefix(e0, bx, by, mx, my, n):
 class GridRayCaster:
     """Stage's ray walk against one static occupancy layer (one ray height).
 
-    ``blocks``: cells holding a block of any model at any height (they decide Stage's empty regions);
-    default ``occupied``."""
+    ``occupied``: the layer in tiles, or a dense (H, W) grid; ``blocks`` (dense only): cells holding a
+    block of any model at any height (they decide Stage's empty regions), default ``occupied``."""
 
     kernels = "numpy"
 
-    def __init__(self, occupied: np.ndarray, resolution: float, origin_xy: tuple[float, float],
+    def __init__(self, occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float],
                  blocks: np.ndarray | None = None) -> None:
-        occ = np.asarray(occupied, dtype=bool)
-        if occ.ndim != 2 or occ.size == 0:
-            raise ValueError("occupied must be a non-empty 2-D array")
         if not resolution > 0:
             raise ValueError("resolution must be positive")
-        self.occupied = occ
+        layer = static_layer(occupied, resolution, origin_xy, blocks)
         self.resolution = float(resolution)
         self.origin_xy = (float(origin_xy[0]), float(origin_xy[1]))
-        self.height, self.width = occ.shape
-        self._squares = quadrant_square_fields(occ).ravel()
-        self._walk_grid = WalkGrid.build(occ if blocks is None else np.asarray(blocks, dtype=bool) | occ,
-                                         self.resolution, self.origin_xy)
+        self.height, self.width = layer.grid.shape
+        self._grid = layer.grid
+        self._tile_of_slot = layer.tile_of_slot
+        self._squares = tile_square_fields(layer.occupied)
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
-        return RobotLayer((self.height, self.width), self._walk_grid)
+        return RobotLayer(self._grid)
 
     def cast(
         self,
@@ -112,7 +113,7 @@ class GridRayCaster:
         cell = np.full(n, -1, dtype=np.int64)
         hit_robot = np.full(n, -1, dtype=np.int32)
         active = robots if robots is not None and robots.active else None
-        regions = robots.regions if robots is not None else self._walk_grid.static_regions
+        regions = robots.regions if robots is not None else None
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             self._walk(rays, own, regions, active, walked, cell, hit_robot)
         return CastResult(ranges=finish_ranges(walked, rmax), hit_cell=cell, hit_robot=hit_robot)
@@ -120,9 +121,8 @@ class GridRayCaster:
     # ------------------------------------------------------------------ the walk, all rays at once
     def _walk(self, rays: WalkRays, own, regions, robots, walked, cell, hit_robot) -> None:
         si, sf = _start_state(rays, own)
-        g = self._walk_grid
-        h, w = self.height, self.width
-        rh, rw = regions.shape
+        g = self._grid
+        w = self.width
         ppm = rays.ppm
         while si.shape[1]:
             # Out of steps: a miss. Left the region: look at the region again.
@@ -132,25 +132,33 @@ class GridRayCaster:
             si[_IN] &= (si[_CX] >= 0) & (si[_CX] < REGION) & (si[_CY] >= 0) & (si[_CY] < REGION)
             outer = np.flatnonzero(si[_IN] == 0)
             if outer.size:
-                self._region_step(si, sf, outer, regions, g, rh, rw)
+                self._region_step(si, sf, outer, regions, g)
             inner = np.flatnonzero(si[_IN] == 1)
             done = np.zeros(si.shape[1], dtype=bool)
             if inner.size:
-                self._cell_step(si, sf, inner, robots, h, w, ppm, walked, cell, hit_robot, done)
+                self._cell_step(si, sf, inner, robots, w, ppm, walked, cell, hit_robot, done)
             if done.any():
                 keep = ~done
                 si, sf = si[:, keep], sf[:, keep]
 
-    def _region_step(self, si, sf, rows, regions, g: WalkGrid, rh: int, rw: int) -> None:
-        """Stage's outer loop for rays ``rows``: enter a region holding blocks, or jump over an empty one."""
+    def _region_step(self, si, sf, rows, regions: np.ndarray | None, g: TileGrid) -> None:
+        """Stage's outer loop for rays ``rows``: enter a region holding blocks (static or robot cells, the
+        latter in ``regions``), or jump over an empty one."""
         globx = sf[_BASEX, rows] + si[_KX, rows]
         globy = sf[_BASEY, rows] + si[_KY, rows]
         ix, iy = globx.astype(np.int64), globy.astype(np.int64)
         rr, rc = (iy >> REGION_BITS) - g.rrow0, (ix >> REGION_BITS) - g.rcol0
+        rh, rw = g.slots.shape
         inside = (rr >= 0) & (rr < rh) & (rc >= 0) & (rc < rw)
-        full = np.zeros(rows.size, dtype=bool)
-        full[inside] = regions[rr[inside], rc[inside]]
+        slot = np.full(rows.size, -1, dtype=np.int64)
+        slot[inside] = g.slots[rr[inside], rc[inside]]
+        robot_tile = np.full(rows.size, -1, dtype=np.int64)
+        if regions is not None:
+            robot_tile[inside] = regions[rr[inside], rc[inside]]
+        full = (slot >= 0) | (robot_tile != -1)
         enter = rows[full]
+        si[_TILE, enter] = np.where(slot[full] >= 0, self._tile_of_slot[slot[full]], -1)
+        si[_RTILE, enter] = robot_tile[full]
         si[_CALC, enter] = 1
         si[_IN, enter] = 1
         si[_CX, enter], si[_CY, enter] = ix[full] & (REGION - 1), iy[full] & (REGION - 1)
@@ -194,22 +202,22 @@ class GridRayCaster:
         sf[_DSX, ys] -= sf[_DSY, ys]
         sf[_DSY, ys] = sf[_YJD, ys]
 
-    def _cell_step(self, si, sf, rows, robots, h, w, ppm, walked, cell, hit_robot, done) -> None:
+    def _cell_step(self, si, sf, rows, robots, w, ppm, walked, cell, hit_robot, done) -> None:
         """One cell of Stage's inner loop for rays ``rows``: a hit, a jump through free space, or one step."""
         r, c = si[_R, rows], si[_C, rows]
         sx, sy, q = si[_SX, rows], si[_SY, rows], si[_Q, rows]
-        on_grid = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-        k = np.ones(rows.size, dtype=np.int64)
+        cx, cy, tile = si[_CX, rows], si[_CY, rows], si[_TILE, rows]
+        # a region with no static tile at this height is free up to its border
+        k = np.minimum(np.where(sx > 0, REGION - cx, cx + 1), np.where(sy > 0, REGION - cy, cy + 1))
+        static = tile >= 0
+        k[static] = self._squares[tile[static], q[static], cy[static], cx[static]]
         kbx = np.full(rows.size, SQUARE_CAP, dtype=np.int64)
         kby = kbx.copy()
-        fr = np.where(sy < 0, h - 1 - r, r)  # the square fields are stored mirrored per quadrant
-        fc = np.where(sx < 0, w - 1 - c, c)
-        flat = (q * h + fr) * w + fc
-        k[on_grid] = self._squares[flat[on_grid]]
         rid = np.full(rows.size, -1, dtype=np.int64)
         if robots is not None:
-            g = np.flatnonzero(on_grid)
-            rid[g], kbx[g], kby[g], plain = robots.look(r[g], c[g], sx[g], sy[g], q[g], si[_OWN, rows[g]])
+            g = np.flatnonzero(si[_RTILE, rows] >= 0)
+            rid[g], kbx[g], kby[g], plain = robots.look(si[_RTILE, rows[g]], cy[g], cx[g], sx[g], sy[g], q[g],
+                                                        si[_OWN, rows[g]])
             k[g[plain]] = np.minimum(k[g[plain]], 1)
         hit = (rid != -1) | (k == 0)
         if hit.any():
@@ -224,10 +232,9 @@ class GridRayCaster:
             done[hr] = True
         go = ~hit
         rows, k, kbx, kby, sx, sy = rows[go], k[go], kbx[go], kby[go], sx[go], sy[go]
-        cx, cy = si[_CX, rows], si[_CY, rows]
         e, bx, by, n = si[_E, rows], si[_BX, rows], si[_BY, rows], si[_N, rows]
-        mx = np.minimum(np.minimum(k, kbx), np.where(sx > 0, REGION - cx, cx + 1)) - 1
-        my = np.minimum(np.minimum(k, kby), np.where(sy > 0, REGION - cy, cy + 1)) - 1
+        mx = np.minimum(k, kbx) - 1  # both squares end at the region's border
+        my = np.minimum(k, kby) - 1
         i, j = walk_prefix(e, bx, by, mx, my, n)
         jump = (k > 1) & (i + j > 0)
         step_x = ~jump & (e < 0)
@@ -247,7 +254,7 @@ class GridRayCaster:
 def _start_state(rays: WalkRays, own: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(integer state, float state) of every ray before its first action, as Stage sets it up."""
     n = own.size
-    si = np.zeros((18, n), dtype=np.int64)
+    si = np.zeros((20, n), dtype=np.int64)
     sf = np.zeros((19, n))
     sx = np.where(rays.dx > 0, 1, np.where(rays.dx < 0, -1, 0))
     sy = np.where(rays.dy > 0, 1, np.where(rays.dy < 0, -1, 0))

@@ -1,24 +1,33 @@
-"""Robots as ray obstacles for the numpy caster: an id per cell, and robot-free squares of blocks.
+"""Robots as ray obstacles: an id per cell in tiles allocated where robots are, and robot-free squares of blocks.
 
 A ray's walk (:mod:`stage_sim.sensing.stage_walk`) hits a robot when it stands in a cell covered by a robot
-other than its owner, exactly as it hits a static cell. To let the walk cross robot-free space in one go,
-the grid is also cut into blocks of ``2**BLOCK`` cells a side: per block, which robot is there (-1 none,
-:data:`SEVERAL_ROBOTS` two or more), and per block and quadrant the largest square of robot-free blocks
-ahead of it (:func:`~stage_sim.sensing.distance_field.quadrant_square_fields` on the blocks). The compiled
-caster keeps the same layer in :class:`~stage_sim.sensing.fast_caster.RobotCells`.
+other than its owner, exactly as it hits a static cell. Robot cells live in tiles of the world's regions
+(:mod:`stage_sim.maps.tiles`), allocated each step for the regions the visible robots' cells fall in. To
+let the walk cross robot-free space in one go, a tile is also cut into blocks of ``2**BLOCK`` cells a side:
+per block, which robot is there (-1 none, :data:`SEVERAL_ROBOTS` two or more), and per block and quadrant
+the largest square of robot-free blocks ahead of it within the tile
+(:func:`~stage_sim.sensing.distance_field.tile_square_fields` on the blocks). Both casters read this layer.
+
+What it costs: the region index, int32 per region (4 B per 1024 cells of the world's bounding box); per
+tile in use 4 KB of ids (int32 per cell), 64 B of block owners and 64 B of block squares. Each update
+touches only the cells the robots cover (O(robot cells), no sort).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from stage_sim.sensing.distance_field import quadrant_square_fields
-from stage_sim.sensing.stage_walk import WalkGrid
+from stage_sim.maps.tiles import TILE, TileGrid
+from stage_sim.sensing.distance_field import tile_square_fields
 
 #: ``hit_robot`` of a cell covered by two or more robots.
 SEVERAL_ROBOTS = -2
 #: Robot occupancy blocks: 2**BLOCK cells a side.
 BLOCK = 3
+#: Blocks per tile side.
+TILE_BLOCKS = TILE >> BLOCK
+#: :attr:`RobotLayer.regions` of a region holding robot cells none of which this layer sees.
+MARKED = -2
 
 
 def visible_cells(
@@ -37,10 +46,11 @@ def visible_cells(
     return rows[keep], cols[keep], ids[keep]
 
 
-def _write(target: np.ndarray, flat: np.ndarray, ids: np.ndarray) -> None:
-    """Write ``ids`` at ``flat`` of ``target``; a place written by two robots holds :data:`SEVERAL_ROBOTS`."""
-    target[flat] = ids
-    target[flat[target[flat] != ids]] = SEVERAL_ROBOTS
+def _write(target: np.ndarray, index: tuple, ids: np.ndarray) -> None:
+    """Write ``ids`` at ``index`` of ``target``; a place written by two robots holds :data:`SEVERAL_ROBOTS`."""
+    target[index] = ids
+    clash = target[index] != ids
+    target[tuple(i[clash] for i in index)] = SEVERAL_ROBOTS
 
 
 class RobotLayer:
@@ -52,16 +62,15 @@ class RobotLayer:
     of the cells, not of :attr:`regions` (Stage's regions count every block).
     """
 
-    def __init__(self, shape: tuple[int, int], walk_grid: WalkGrid) -> None:
-        self.shape = shape
-        self._walk_grid = walk_grid
-        self.regions = walk_grid.static_regions
-        self.grid = np.full(shape, -1, dtype=np.int32)
-        size = 1 << BLOCK
-        self.blocks = np.full((-(-shape[0] // size), -(-shape[1] // size)), -1, dtype=np.int32)
-        self._blocks_in_use = self.blocks != -1
-        self._block_squares = quadrant_square_fields(self._blocks_in_use).ravel()
-        self._written = np.empty(0, dtype=np.int64)
+    def __init__(self, grid: TileGrid) -> None:
+        self.grid = grid
+        self.shape = grid.shape
+        #: (R, C) int32 per region: its robot tile, :data:`MARKED`, or -1 (no robot cell there)
+        self.regions = np.full(grid.slots.shape, -1, dtype=np.int32)
+        self.ids = np.full((0, TILE, TILE), -1, dtype=np.int32)  #: (T, 32, 32) robot id per cell
+        self.blocks = np.full((0, TILE_BLOCKS, TILE_BLOCKS), -1, dtype=np.int32)  #: robot per 8 × 8 block
+        self.block_squares = np.zeros((0, 4, TILE_BLOCKS, TILE_BLOCKS), dtype=np.uint8)
+        self._marked = np.empty(0, dtype=np.int64)
         self.active = False
 
     def update(
@@ -74,41 +83,53 @@ class RobotLayer:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
         self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
-        grid, blocks = self.grid.ravel(), self.blocks.ravel()
-        old = self._written
-        grid[old] = -1
-        blocks[(old // self.shape[1] >> BLOCK) * self.blocks.shape[1] + (old % self.shape[1] >> BLOCK)] = -1
-        flat = rows * self.shape[1] + cols
-        _write(grid, flat, ids)
-        _write(blocks, (rows >> BLOCK) * self.blocks.shape[1] + (cols >> BLOCK), ids)
-        in_use = self.blocks != -1
-        if not np.array_equal(in_use, self._blocks_in_use):  # standing or jammed robots keep their blocks
-            self._blocks_in_use = in_use
-            self._block_squares = quadrant_square_fields(in_use).ravel()
-        self._written = flat
-        self.active = flat.size > 0
+        rr, rc, ty, tx = self.grid.locate(rows * self.shape[1] + cols)
+        region = rr * self.regions.shape[1] + rc
+        flat_regions = self.regions.ravel()
+        # Number the regions without sorting: each region keeps the last entry written to it, then the
+        # entries that won are numbered in order.
+        flat_regions[region] = np.arange(region.size, dtype=np.int32)
+        winner = flat_regions[region]
+        first = np.zeros(region.size, dtype=bool)
+        first[winner] = True
+        number = np.cumsum(first, dtype=np.int32) - 1
+        tile = number[winner]
+        flat_regions[region] = tile
+        count = int(first.sum())
+        if count > self.ids.shape[0]:
+            capacity = max(count, 2 * self.ids.shape[0])
+            self.ids = np.empty((capacity, TILE, TILE), dtype=np.int32)
+            self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
+        self.ids[:count] = -1
+        self.blocks[:count] = -1
+        _write(self.ids, (tile, ty, tx), ids.astype(np.int32))
+        _write(self.blocks, (tile, ty >> BLOCK, tx >> BLOCK), ids.astype(np.int32))
+        self.block_squares = tile_square_fields(self.blocks[:count] != -1)
+        self.active = rows.size > 0
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
+        flat_regions = self.regions.ravel()
+        flat_regions[self._marked] = -1
         rows, cols, _ = visible_cells(cell_rows, cell_cols, np.zeros(np.size(cell_rows), dtype=np.int64), self.shape,
                                       None)
-        self.regions = self._walk_grid.with_cells(rows, cols)
+        rr, rc, _, _ = self.grid.locate(rows * self.shape[1] + cols)
+        self._marked = rr * self.regions.shape[1] + rc
+        flat_regions[self._marked] = MARKED
 
-    def look(self, r, c, sx, sy, q, owner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """For walks standing in grid cells (r, c): (robot hit or -1, free cells ahead along x, along y, and
-        whether a robot in the cell's block allows only one plain step)."""
-        bh, bw = self.blocks.shape
-        bby, bbx = r >> BLOCK, c >> BLOCK
-        fy = np.where(sy < 0, bh - 1 - bby, bby)
-        fx = np.where(sx < 0, bw - 1 - bbx, bbx)
-        side = self._block_squares[(q * bh + fy) * bw + fx].astype(np.int64)
-        block = self.blocks[bby, bbx]
+    def look(self, tile, cy, cx, sx, sy, q, owner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """For walks standing in cell (cy, cx) of robot tile ``tile`` (≥ 0): (robot hit or -1, free cells ahead
+        along x, along y, and whether a robot in the cell's block allows only one plain step)."""
+        bby, bbx = cy >> BLOCK, cx >> BLOCK
+        side = self.block_squares[tile, q, bby, bbx].astype(np.int64)
+        block = self.blocks[tile, bby, bbx]
         occupied = side == 0
         mine = occupied & ((block == -1) | (block == owner))
         side[mine] = 1
         plain = occupied & ~mine
-        rid = np.where(plain, self.grid[r, c], -1).astype(np.int64)
+        rid = np.where(plain, self.ids[tile, cy, cx], -1).astype(np.int64)
         rid[(rid == owner)] = -1
-        kbx = np.where(sx >= 0, ((bbx + side) << BLOCK) - c, c + 1 - ((bbx - side + 1) << BLOCK))
-        kby = np.where(sy >= 0, ((bby + side) << BLOCK) - r, r + 1 - ((bby - side + 1) << BLOCK))
+        kbx = np.where(sx >= 0, ((bbx + side) << BLOCK) - cx, cx + 1 - ((bbx - side + 1) << BLOCK))
+        kby = np.where(sy >= 0, ((bby + side) << BLOCK) - cy, cy + 1 - ((bby - side + 1) << BLOCK))
         return rid, kbx, kby, plain
+

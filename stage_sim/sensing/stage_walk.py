@@ -22,8 +22,9 @@ being world cell ``round(origin / resolution)``. Robots are cells too: a cell co
 than the ray's own blocks it, as a static cell does.
 
 This module holds what both implementations share: the per-ray constants, computed by the same numpy
-calls for both, and the region grid. The walk itself runs in :mod:`stage_sim.sensing.traversal` (numba)
-and :mod:`stage_sim.sensing.raycast` (numpy), which must agree bit for bit. Both skip free space with
+calls for both, and the static layer in tiles of regions (:mod:`stage_sim.maps.tiles`). The walk itself
+runs in :mod:`stage_sim.sensing.traversal` (numba) and :mod:`stage_sim.sensing.raycast` (numpy), which
+must agree bit for bit. Both skip free space with
 free squares without changing an answer: every cell skipped is free, and the reported distance depends
 only on how many steps were taken along each axis since the last region jump (``base + count``).
 """
@@ -34,45 +35,29 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Cells per region side (Stage's ``RBITS = 5``).
-REGION_BITS = 5
-REGION = 1 << REGION_BITS
+from stage_sim.maps.tiles import TILE, TILE_BITS, TileGrid, TileLayer
+
+#: Cells per region side (Stage's ``RBITS = 5``): the world's tiles are its regions.
+REGION_BITS = TILE_BITS
+REGION = TILE
 #: Stage turns a beam at exactly angle 0 into this angle (a zero sine would divide by zero).
 ZERO_ANGLE = 1e-12
 
 
-@dataclass(frozen=True)
-class WalkGrid:
-    """Where a caster's grid lies in Stage's world cells, and which of its regions hold blocks."""
-
-    col0: int  #: world cell column of the grid's column 0
-    row0: int  #: world cell row of the grid's row 0
-    rcol0: int  #: region column of the region grid's column 0
-    rrow0: int
-    static_regions: np.ndarray  #: (R, C) bool: regions holding a static block cell
-
-    @classmethod
-    def build(cls, blocks: np.ndarray, resolution: float, origin_xy: tuple[float, float]) -> WalkGrid:
-        """The grid of ``blocks`` (cells holding any block) placed at ``origin_xy`` (snapped to a cell)."""
-        col0 = round(origin_xy[0] / resolution)
-        row0 = round(origin_xy[1] / resolution)
-        h, w = blocks.shape
-        rcol0, rrow0 = col0 >> REGION_BITS, row0 >> REGION_BITS
-        shape = (((row0 + h - 1) >> REGION_BITS) - rrow0 + 1, ((col0 + w - 1) >> REGION_BITS) - rcol0 + 1)
-        grid = cls(col0, row0, rcol0, rrow0, np.zeros(shape, dtype=bool))
-        rows, cols = np.nonzero(blocks)
-        grid.static_regions[grid.region_index(rows, cols)] = True
-        return grid
-
-    def region_index(self, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(region rows, region cols) in the region grid of grid cells (rows, cols)."""
-        return (((rows + self.row0) >> REGION_BITS) - self.rrow0, ((cols + self.col0) >> REGION_BITS) - self.rcol0)
-
-    def with_cells(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """The region grid with the regions of grid cells (rows, cols) marked too (robots' blocks)."""
-        regions = self.static_regions.copy()
-        regions[self.region_index(rows, cols)] = True
-        return regions
+def static_layer(
+    occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float],
+    blocks: np.ndarray | None = None,
+) -> TileLayer:
+    """A caster's static layer: ``occupied`` itself when it is already in tiles, else the tiles of a dense
+    (H, W) grid placed at ``origin_xy`` whose regions hold blocks where ``blocks | occupied`` has a cell."""
+    if isinstance(occupied, TileLayer):
+        return occupied
+    occ = np.asarray(occupied, dtype=bool)
+    if occ.ndim != 2 or occ.size == 0:
+        raise ValueError("occupied must be a non-empty 2-D array")
+    every = occ if blocks is None else np.asarray(blocks, dtype=bool) | occ
+    grid = TileGrid.build(occ.shape, resolution, origin_xy, np.flatnonzero(every))
+    return TileLayer.from_cells(grid, np.flatnonzero(occ))
 
 
 @dataclass(frozen=True)

@@ -5,20 +5,22 @@ true ray's: see there), statement for statement where it decides anything: the r
 jumps with their crossings, the error term, the step count, the reported distance. Robots are checked
 before the static map in every cell (a ray never sees its owner).
 
-Free space inside a region holding blocks is crossed in one go without changing any answer: from the
-current cell the walk may take any number of steps that keep it inside
+The world is read through its tiles (:mod:`stage_sim.maps.tiles`): a region holds blocks if it has a static
+slot or robot cells; on entering one, the walk looks up its static tile (none: every cell free at this
+height) and its robot tile once. Free space inside the region is crossed in one go without changing any
+answer: from the current cell the walk may take any number of steps that keep it inside
 
-* the largest free square with the cell as its corner in the ray's quadrant (:func:`square_fields`, one
-  uint8 per cell and quadrant; 0 marks an occupied cell);
-* the square of robot-free 8-cell blocks from the cell's block, when robots are about (or the cell's own
-  block if no robot but the ray's own is there) (:class:`~stage_sim.sensing.fast_caster.RobotCells`);
-* the largest square of regions holding blocks from the cell's region (:func:`region_squares`), and the
-  current region itself unless the cells Stage would look up afresh on crossing a region border are the
-  cells walked (:func:`_rereads_agree`);
+* the largest free square with the cell as its corner in the ray's quadrant, within the tile
+  (:func:`~stage_sim.sensing.distance_field.tile_square_fields`; 0 marks an occupied cell; a region
+  without a static tile: the square up to the region's border);
+* the square of robot-free 8-cell blocks from the cell's block within the tile, when robots are about (or
+  the cell's own block if no robot but the ray's own is there)
+  (:class:`~stage_sim.sensing.robot_layer.RobotLayer`);
 
-and within its remaining step count; the cell reached is free, so the next step follows at once. Where the
-walk stands after i steps along x and j along y is known in closed form (:func:`walk_prefix`), so the jump
-lands on the very cell, error term and count of the walk; short stretches are stepped through (cheaper).
+and within its remaining step count; the cell reached is free and in the region, so the next step follows
+at once. Where the walk stands after i steps along x and j along y is known in closed form
+(:func:`walk_prefix`), so the jump lands on the very cell, error term and count of the walk; short
+stretches are stepped through (cheaper).
 """
 
 from __future__ import annotations
@@ -28,11 +30,10 @@ import math
 import numba
 import numpy as np
 
+from stage_sim.sensing.distance_field import SQUARE_CAP
 from stage_sim.sensing.robot_layer import BLOCK
 from stage_sim.sensing.stage_walk import REGION, REGION_BITS
 
-#: Largest free-square side stored (uint8).
-SQUARE_CAP = 255
 #: Free stretches longer than this (steps) are crossed by :func:`walk_prefix`'s arithmetic, shorter ones
 #: step by step.
 JUMP_STEPS = 40
@@ -94,17 +95,6 @@ def _step_through(e, bx, by, mx, my, n):
 
 
 @numba.njit(inline="always", **_JIT)
-def _rereads_agree(basex, basey, kx, ky, gx, gy, di, dj):
-    """Whether Stage's fresh look at ``int(globx), int(globy)`` on crossing a region border gives the cell walked.
-
-    It does unless a coordinate changes sign on the way or ``base + k`` rounds onto a whole number; both would
-    show at one end of the stretch (the truncation is monotonic in the magnitude), so both ends are checked.
-    """
-    return (int(basex + kx) == gx and int(basey + ky) == gy and int(basex + (kx + di)) == gx + di
-            and int(basey + (ky + dj)) == gy + dj)
-
-
-@numba.njit(inline="always", **_JIT)
 def _prefix(e, bx, by, mx, my, n):
     """:func:`walk_prefix`, step by step for short stretches (cheaper than its divisions)."""
     if mx + my > JUMP_STEPS:
@@ -113,11 +103,10 @@ def _prefix(e, bx, by, mx, my, n):
 
 
 @numba.njit(**_JIT)
-def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region_squares, col0, row0, rcol0, rrow0,
-             startx, starty, cosa, sina, tana, dx, dy, ppm, owner):
+def walk_ray(squares, tile_of_slot, slots, robot_regions, robot_ids, robot_blocks, block_squares, use_regions,
+             use_robots, col0, row0, rcol0, rrow0, width, startx, starty, cosa, sina, tana, dx, dy, ppm, owner):
     """(range in metres or inf, flat cell or -1, robot id or -1) of one ray walked as Stage walks it."""
-    h, w = squares.shape[1], squares.shape[2]
-    rh, rw = regions.shape
+    rh, rw = slots.shape
     sx = 1 if dx > 0 else (-1 if dx < 0 else 0)
     sy = 1 if dy > 0 else (-1 if dy < 0 else 0)
     ax = np.int64(abs(dx))
@@ -126,7 +115,6 @@ def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region
     exy = ay - ax
     n = ax + ay
     quadrant = (1 if sx < 0 else 0) + (2 if sy < 0 else 0)
-    square = squares[quadrant]
     xjumpx, xjumpy = float(sx * REGION), (sx * REGION) * tana
     yjumpx, yjumpy = (sy * REGION) / tana, float(sy * REGION)
     xjumpdist = abs(xjumpx) + abs(xjumpy)
@@ -139,54 +127,48 @@ def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region
         globx, globy = basex + kx, basey + ky
         ix, iy = int(globx), int(globy)  # C's truncation, as Stage's GETREG gets it
         rr, rc = (iy >> REGION_BITS) - rrow0, (ix >> REGION_BITS) - rcol0
-        if 0 <= rr < rh and 0 <= rc < rw and regions[rr, rc]:
+        slot = rtile = -1
+        if 0 <= rr < rh and 0 <= rc < rw:
+            slot = slots[rr, rc]
+            if use_regions:
+                rtile = robot_regions[rr, rc]
+        if slot >= 0 or rtile != -1:
             calculate_crossings = True
+            tile = tile_of_slot[slot] if slot >= 0 else -1
             cx, cy = ix & (REGION - 1), iy & (REGION - 1)
-            r, c = iy - row0, ix - col0
             while 0 <= cx < REGION and 0 <= cy < REGION and n > 0:
-                k = 1
+                if tile >= 0:
+                    k = np.int64(squares[tile, quadrant, cy, cx])
+                else:  # nothing static at this height in the region: free up to its border
+                    k = min(REGION - cx if sx > 0 else cx + 1, REGION - cy if sy > 0 else cy + 1)
                 kbx = kby = SQUARE_CAP
-                if 0 <= r < h and 0 <= c < w:
-                    k = np.int64(square[r, c])
-                    if use_robots:  # a square of robot-free blocks, or a block with no robot but the ray's own
-                        bbx, bby = c >> BLOCK, r >> BLOCK
-                        side = np.int64(block_squares[quadrant, bby, bbx])
-                        if side == 0:
-                            block = blocks[bby, bbx]
-                            if block == -1 or block == owner:
-                                side = 1
-                            else:
-                                rid = robots[r, c]
-                                if rid != -1 and rid != owner:
-                                    return _distance(ax, ay, basex + kx, basey + ky, startx, starty, cosa, sina,
-                                                     ppm), r * w + c, rid
-                                k = min(k, 1)
-                        kbx = ((bbx + side) << BLOCK) - c if sx >= 0 else c + 1 - ((bbx - side + 1) << BLOCK)
-                        kby = ((bby + side) << BLOCK) - r if sy >= 0 else r + 1 - ((bby - side + 1) << BLOCK)
-                    if k == 0:
-                        return _distance(ax, ay, basex + kx, basey + ky, startx, starty, cosa, sina, ppm), r * w + c, -1
+                if use_robots and rtile >= 0:  # a square of robot-free blocks, or a block with no robot but ours
+                    bbx, bby = cx >> BLOCK, cy >> BLOCK
+                    side = np.int64(block_squares[rtile, quadrant, bby, bbx])
+                    if side == 0:
+                        block = robot_blocks[rtile, bby, bbx]
+                        if block == -1 or block == owner:
+                            side = 1
+                        else:
+                            rid = robot_ids[rtile, cy, cx]
+                            if rid != -1 and rid != owner:
+                                return _distance(ax, ay, basex + kx, basey + ky, startx, starty, cosa, sina,
+                                                 ppm), (iy - row0) * width + ix - col0, rid
+                            k = min(k, 1)
+                    kbx = ((bbx + side) << BLOCK) - cx if sx >= 0 else cx + 1 - ((bbx - side + 1) << BLOCK)
+                    kby = ((bby + side) << BLOCK) - cy if sy >= 0 else cy + 1 - ((bby - side + 1) << BLOCK)
+                if k == 0:
+                    return (_distance(ax, ay, basex + kx, basey + ky, startx, starty, cosa, sina, ppm),
+                            (iy - row0) * width + ix - col0, -1)
                 if k > 1:
-                    gx, gy = c + col0, r + row0
-                    rgx, rgy = gx >> REGION_BITS, gy >> REGION_BITS
-                    side = np.int64(region_squares[quadrant, rgy - rrow0, rgx - rcol0])
-                    krx = ((rgx + side) << REGION_BITS) - gx if sx >= 0 else gx + 1 - ((rgx - side + 1) << REGION_BITS)
-                    kry = ((rgy + side) << REGION_BITS) - gy if sy >= 0 else gy + 1 - ((rgy - side + 1) << REGION_BITS)
-                    mx = min(k, kbx, krx) - 1
-                    my = min(k, kby, kry) - 1
-                    i, j = _prefix(exy, bx, by, mx, my, n)
-                    ex, ey = cx + i * sx, cy + j * sy
-                    if not (0 <= ex < REGION and 0 <= ey < REGION) and not _rereads_agree(
-                            basex, basey, kx, ky, gx, gy, i * sx, j * sy):
-                        mx = min(mx, REGION - 1 - cx if sx > 0 else cx)
-                        my = min(my, REGION - 1 - cy if sy > 0 else cy)
-                        i, j = _prefix(exy, bx, by, mx, my, n)
+                    i, j = _prefix(exy, bx, by, min(k, kbx) - 1, min(k, kby) - 1, n)
                     if i + j > 0:
                         kx += i * sx
-                        c += i * sx
+                        ix += i * sx
+                        cx += i * sx
                         ky += j * sy
-                        r += j * sy
-                        cx = (c + col0) & (REGION - 1)
-                        cy = (r + row0) & (REGION - 1)
+                        iy += j * sy
+                        cy += j * sy
                         exy += i * by - j * bx
                         n -= i + j
                         if n <= 0:
@@ -196,12 +178,12 @@ def walk_ray(squares, robots, use_robots, blocks, block_squares, regions, region
                     kx += sx
                     exy += by
                     cx += sx
-                    c += sx
+                    ix += sx
                 else:
                     ky += sy
                     exy -= bx
                     cy += sy
-                    r += sy
+                    iy += sy
                 n -= 1
         else:
             if calculate_crossings:
@@ -247,96 +229,36 @@ def _distance(ax, ay, globx, globy, startx, starty, cosa, sina, ppm):
 
 
 @numba.njit(**_JIT)
-def _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
-                rmax, ppm, owner, out, cell, rid, a, b):
-    col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
+def _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, a, b):
+    squares, tile_of_slot, slots = world
+    robot_regions, robot_ids, robot_blocks, block_squares = robots
+    use_regions, use_robots = flags[0], flags[1]
+    col0, row0, rcol0, rrow0, width = place[0], place[1], place[2], place[3], place[4]
     for i in range(a, b):
         c, s = cosa[i], sina[i]
         reach = ppm * rmax[i]  # the arithmetic of stage_walk.WalkRays, operation for operation
-        walked, cell[i], rid[i] = walk_ray(squares, robots, use_robots, blocks, block_squares, regions,
-                                           region_squares, col0, row0, rcol0, rrow0, xy[i, 0] * ppm, xy[i, 1] * ppm,
-                                           c, s, s / c, reach * c, reach * s, ppm, owner[i])
+        walked, cell[i], rid[i] = walk_ray(squares, tile_of_slot, slots, robot_regions, robot_ids, robot_blocks,
+                                           block_squares, use_regions, use_robots, col0, row0, rcol0, rrow0, width,
+                                           xy[i, 0] * ppm, xy[i, 1] * ppm, c, s, s / c, reach * c, reach * s, ppm,
+                                           owner[i])
         out[i] = walked if cell[i] >= 0 else rmax[i]
 
 
 @numba.njit(**_JIT)
-def cast_serial(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
-                rmax, ppm, owner, out, cell, rid):
+def cast_serial(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid):
     """Every ray in order, on the calling thread: ranges in metres (exactly ``rmax`` on a miss) into ``out``.
 
+    ``world``: (static tile squares, tile of each slot, slot of each region); ``robots``: the arrays of a
+    :class:`~stage_sim.sensing.robot_layer.RobotLayer`; ``flags``: (use its regions, use its cells);
     ``cosa``, ``sina``: of Stage's beam angles (:func:`~stage_sim.sensing.stage_walk.beam_cos_sin`);
-    ``place``: col0, row0, rcol0, rrow0 of :class:`~stage_sim.sensing.stage_walk.WalkGrid`."""
-    _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
-                rmax, ppm, owner, out, cell, rid, 0, owner.size)
+    ``place``: col0, row0, rcol0, rrow0 of the :class:`~stage_sim.maps.tiles.TileGrid` and its width."""
+    _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, 0, owner.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa, sina,
-                  rmax, ppm, owner, out, cell, rid):
+def cast_parallel(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(squares, robots, use_robots, blocks, block_squares, regions, region_squares, place, xy, cosa,
-                    sina, rmax, ppm, owner, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
-
-
-@numba.njit(**_JIT)
-def square_fields(occupied):
-    """(4, H, W) uint8: side of the largest free square with the cell as its corner, towards quadrant q.
-
-    q = (dx < 0) + 2·(dy < 0); cells beyond the grid are free; 0 iff the cell is occupied; capped at
-    :data:`SQUARE_CAP`. The recurrence k = 1 + min(k(x+sx), k(y+sy), k(x+sx, y+sy)).
-    """
-    h, w = occupied.shape
-    out = np.empty((4, h, w), dtype=np.uint8)
-    for q in range(4):
-        sx = -1 if q & 1 else 1
-        sy = -1 if q & 2 else 1
-        for j in range(h):
-            y = h - 1 - j if sy > 0 else j
-            for i in range(w):
-                x = w - 1 - i if sx > 0 else i
-                if occupied[y, x]:
-                    out[q, y, x] = 0
-                    continue
-                xn, yn = x + sx, y + sy
-                x_in, y_in = 0 <= xn < w, 0 <= yn < h
-                side = SQUARE_CAP
-                if x_in:
-                    side = min(side, np.int64(out[q, y, xn]))
-                if y_in:
-                    side = min(side, np.int64(out[q, yn, x]))
-                if x_in and y_in:
-                    side = min(side, np.int64(out[q, yn, xn]))
-                out[q, y, x] = min(side + 1, SQUARE_CAP)
-    return out
-
-
-def region_squares(regions: np.ndarray) -> np.ndarray:
-    """(4, R, C) uint8: side of the largest square of regions holding blocks from each region, per quadrant
-    (0 for an empty region; regions beyond the grid are empty)."""
-    padded = np.ones((regions.shape[0] + 2, regions.shape[1] + 2), dtype=np.bool_)
-    padded[1:-1, 1:-1] = ~regions
-    return np.ascontiguousarray(square_fields(padded)[:, 1:-1, 1:-1])
-
-
-@numba.njit(**_JIT)
-def write_robot_cells(grid, blocks, old, flat, ids, several):
-    """Clear the cells ``old`` of ``grid``, then write robot ``ids[i]`` into cell ``flat[i]``.
-
-    A cell written by two robots holds ``several``. ``blocks`` says per block which robots have cells
-    there: -1 none, ``several`` two or more, else the one robot's id.
-    """
-    w = grid.shape[1]
-    g = grid.ravel()
-    for f in old:
-        g[f] = -1
-        r, c = f // w, f % w
-        blocks[r >> BLOCK, c >> BLOCK] = -1
-    for i in range(flat.size):
-        f = flat[i]
-        robot = ids[i]
-        g[f] = robot if g[f] == -1 or g[f] == robot else several
-        r, c = f // w, f % w
-        b = blocks[r >> BLOCK, c >> BLOCK]
-        blocks[r >> BLOCK, c >> BLOCK] = robot if b == -1 or b == robot else several
+        _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, k * _CHUNK,
+                    min(n, (k + 1) * _CHUNK))

@@ -2,11 +2,12 @@
 
 A robot's body is a cloud of outline points in its own frame (see :mod:`stage_sim.sim.robots`).
 Placing all robots is one vectorised transform of all points; the cells they fall in are checked against
-the static collision layer and against each other with an owner grid (write every robot's id into its
-cells, read them back: a cell that reads another id is shared). As in Stage, a move that makes a body share
-a cell with an obstacle (a static cell with ``obstacle_return`` or another robot) is undone and the robot
-is marked stalled. Moves longer than half the body's width are checked at intermediate poses so that no
-speed the bounds allow can carry a body through a wall one cell thick.
+the static collision layer (in tiles, :class:`~stage_sim.maps.tiles.TileLayer`) and against each other by
+the cells they share (sorted (cell, robot) pairs, or a hash table of the robots' cells in the compiled
+path: memory in proportion to the robots' cells, 16-32 B each, never to the world's area). As in Stage,
+a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
+robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
+intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stage_sim.maps.polygon_raster import point_cells
+from stage_sim.maps.tiles import TileLayer
 from stage_sim.sim.kinematics import integrate
 
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
@@ -79,18 +81,17 @@ class CollisionChecker:
     """Decides which robot moves to accept, given the static cells that block each robot's height band."""
 
     def __init__(
-        self, bodies: Bodies, grid: GridFrame, layers: list[np.ndarray], layer_of_robot: np.ndarray,
+        self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
         collides: np.ndarray,
     ) -> None:
         self.bodies = bodies
         self.grid = grid
-        self._layers = [layer.ravel() for layer in layers]
+        self._layers = layers
         self._layer_of_robot = layer_of_robot
         self._collides = collides
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-        self._owner_grid = np.full(grid.shape[0] * grid.shape[1], -1, dtype=np.int64)
 
     def resolve(self, poses: np.ndarray, velocities: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Move every robot by one step; returns (new poses, refused) with refused moves undone.
@@ -146,7 +147,7 @@ class CollisionChecker:
         hit = np.zeros(len(cells), dtype=bool)
         for i, layer in enumerate(self._layers):
             use = (layer_index == i) & (cells >= 0)
-            hit[use] = layer[cells[use]]
+            hit[use] = layer.contains(cells[use])
         return (np.bincount(point_robot[hit], minlength=self.bodies.count) > 0)[movers]
 
     def _robot_conflicts(self, poses: np.ndarray) -> np.ndarray:
@@ -161,15 +162,12 @@ class CollisionChecker:
         if self.grid.kernels == "numba":
             from stage_sim.sim.collision_kernels import owner_clashes
 
-            owner_clashes(cells, owner, self._owner_grid, conflict)
+            owner_clashes(cells, owner, conflict)
             return conflict
         keep = cells >= 0
-        cells, owner = cells[keep], owner[keep]
-        grid = self._owner_grid
-        grid[cells] = owner
-        seen = grid[cells]
-        clash = seen != owner
-        conflict[owner[clash]] = True
-        conflict[seen[clash]] = True
-        grid[cells] = -1
+        robots = np.int64(len(poses))
+        pairs = np.unique(cells[keep] * robots + owner[keep])  # each (cell, robot) once, by cell
+        shared = pairs[1:] // robots == pairs[:-1] // robots
+        conflict[pairs[1:][shared] % robots] = True
+        conflict[pairs[:-1][shared] % robots] = True
         return conflict

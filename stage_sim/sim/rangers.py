@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
+from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
@@ -25,7 +26,7 @@ from stage_sim.sim.collision import Bodies, GridFrame, place
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
-    from stage_sim.sensing.fast_caster import NumbaRayCaster, RobotCells
+    from stage_sim.sensing.fast_caster import NumbaRayCaster
 
 
 @dataclass
@@ -47,8 +48,8 @@ class _HeightGroup:
     angle: np.ndarray
     max_range: np.ndarray
     caster: GridRayCaster | NumbaRayCaster
-    robots: RobotLayer | RobotCells
-    intensity: np.ndarray
+    robots: RobotLayer
+    intensity: CellValues
     robot_visible: np.ndarray
     robot_return: np.ndarray
 
@@ -165,7 +166,7 @@ class RangerSensing:
         ranges[rays] = result.ranges
         static_hit = result.hit_cell >= 0
         hits = np.zeros(len(rays), dtype=np.float32)
-        hits[static_hit] = group.intensity.ravel()[result.hit_cell[static_hit]]
+        hits[static_hit] = group.intensity.at(result.hit_cell[static_hit])
         robot_hit = result.hit_robot >= 0
         hits[robot_hit] = group.robot_return[result.hit_robot[robot_hit]]
         # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
@@ -204,9 +205,9 @@ class RangerSensing:
         groups = []
         returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
         for height in np.unique(ray_height):
-            occupied, intensity = static.sensing_layer(float(height))
+            occupied, intensity = static.sensing_tiles(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
-            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads, static.blocks)
+            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
             rays = np.flatnonzero(ray_height == height)
             groups.append(_HeightGroup(
                 rays=rays,

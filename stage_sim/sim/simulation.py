@@ -244,7 +244,7 @@ class Simulation:
 
     def _make_collision_checker(self, grid: GridFrame) -> CollisionChecker:
         bands = sorted({r.z_band for r in self.robots})
-        layers = [self.static.collision_layer(*band) for band in bands]
+        layers = [self.static.collision_tiles(*band) for band in bands]
         layer_of_robot = np.array([bands.index(r.z_band) for r in self.robots], dtype=np.int64)
         collides = np.array([r.model.obstacle_return for r in self.robots], dtype=bool)
         return CollisionChecker(self._bodies, grid, layers, layer_of_robot, collides)
