@@ -19,6 +19,7 @@ What it costs:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -158,10 +159,14 @@ class CellValues:
         last[:-1] = flat[1:] != flat[:-1]
         return cls(flat[last], values[last])
 
+    @cached_property
+    def uniform(self) -> bool:
+        """Whether every cell holds the same value (the common case: one ``ranger_return`` for all)."""
+        return bool(np.all(self.values == self.values[0])) if self.values.size else True
+
     def at(self, flat: np.ndarray) -> np.ndarray:
-        """The value of each flat cell (0 where the set has none)."""
+        """The value of each of the flat cells ``flat``, every one of them in the set (a ray's static hit)."""
         flat = np.asarray(flat, dtype=np.int64)
-        if self.cells.size == 0:
-            return np.zeros(flat.shape, dtype=np.float32)
-        where = np.minimum(np.searchsorted(self.cells, flat), self.cells.size - 1)
-        return np.where(self.cells[where] == flat, self.values[where], np.float32(0.0))
+        if self.uniform:
+            return np.full(flat.shape, self.values[0] if self.values.size else 0.0, dtype=np.float32)
+        return self.values[np.searchsorted(self.cells, flat)]

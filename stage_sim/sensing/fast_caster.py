@@ -15,7 +15,6 @@ import numpy as np
 
 from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing import traversal
-from stage_sim.sensing.distance_field import tile_square_fields
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
@@ -34,21 +33,21 @@ class NumbaRayCaster:
                  threads: int = 1, blocks: np.ndarray | None = None):
         if not resolution > 0:
             raise ValueError("resolution must be positive")
-        announce_compilation(traversal.cast_serial)
+        announce_compilation(traversal.cast_serial, traversal.tile_square_fields)
         layer = static_layer(occupied, resolution, origin_xy, blocks)
         self.resolution = float(resolution)
         self.origin_xy = (float(origin_xy[0]), float(origin_xy[1]))
         self.height, self.width = layer.grid.shape
         self.threads = threads
         self._grid = layer.grid
-        self._world = (tile_square_fields(layer.occupied), layer.tile_of_slot, layer.grid.slots)
+        self._world = (traversal.tile_square_fields(layer.occupied), layer.tile_of_slot, layer.grid.slots)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
                            np.full((1, 1, 1), -1, dtype=np.int32), np.zeros((1, 1, 1, 1), dtype=np.uint8))
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
-        return RobotLayer(self._grid)
+        return RobotLayer(self._grid, compiled=True)
 
     def cast(
         self,

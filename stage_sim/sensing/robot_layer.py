@@ -62,8 +62,10 @@ class RobotLayer:
     of the cells, not of :attr:`regions` (Stage's regions count every block).
     """
 
-    def __init__(self, grid: TileGrid) -> None:
+    def __init__(self, grid: TileGrid, compiled: bool = False) -> None:
+        """``compiled``: update with the numba kernels (:mod:`stage_sim.sensing.robot_kernels`), same result."""
         self.grid = grid
+        self.compiled = compiled
         self.shape = grid.shape
         #: (R, C) int32 per region: its robot tile, :data:`MARKED`, or -1 (no robot cell there)
         self.regions = np.full(grid.slots.shape, -1, dtype=np.int32)
@@ -81,6 +83,9 @@ class RobotLayer:
         visible: np.ndarray | None = None,
     ) -> None:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
+        if self.compiled:
+            self._update_compiled(cell_rows, cell_cols, robot_ids, visible)
+            return
         self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         rr, rc, ty, tx = self.grid.locate(rows * self.shape[1] + cols)
@@ -96,16 +101,35 @@ class RobotLayer:
         tile = number[winner]
         flat_regions[region] = tile
         count = int(first.sum())
-        if count > self.ids.shape[0]:
-            capacity = max(count, 2 * self.ids.shape[0])
-            self.ids = np.empty((capacity, TILE, TILE), dtype=np.int32)
-            self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
+        self._reserve(count)
         self.ids[:count] = -1
         self.blocks[:count] = -1
         _write(self.ids, (tile, ty, tx), ids.astype(np.int32))
         _write(self.blocks, (tile, ty >> BLOCK, tx >> BLOCK), ids.astype(np.int32))
         self.block_squares = tile_square_fields(self.blocks[:count] != -1)
         self.active = rows.size > 0
+
+    def _update_compiled(self, cell_rows, cell_cols, robot_ids, visible) -> None:
+        from stage_sim.sensing import robot_kernels, traversal
+
+        rows = np.asarray(cell_rows, dtype=np.int64).ravel()
+        ids = np.asarray(robot_ids, dtype=np.int64).ravel()
+        seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
+        place = np.append(self.grid.place, self.shape[0])
+        self._marked, tile, local, count = robot_kernels.number_robot_regions(
+            self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(), ids, seen, place,
+            self.shape[1], MARKED)
+        self._reserve(count)
+        self.active = robot_kernels.write_robot_tiles(self.ids, self.blocks, tile, local, ids.astype(np.int32),
+                                                      count, SEVERAL_ROBOTS, BLOCK)
+        self.block_squares = traversal.tile_square_fields(self.blocks[:count] != -1)
+
+    def _reserve(self, count: int) -> None:
+        """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
+        if count > self.ids.shape[0]:
+            capacity = max(count, 2 * self.ids.shape[0])
+            self.ids = np.empty((capacity, TILE, TILE), dtype=np.int32)
+            self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""

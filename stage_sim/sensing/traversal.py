@@ -262,3 +262,29 @@ def cast_parallel(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner,
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
         _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, k * _CHUNK,
                     min(n, (k + 1) * _CHUNK))
+
+
+@numba.njit(**_JIT)
+def tile_square_fields(occupied):
+    """:func:`stage_sim.sensing.distance_field.tile_square_fields`, compiled: (T, 4, S, S) uint8 sides of the
+    largest free square within the tile from each cell towards quadrant q, by ``k = 1 + min(k(x+sx),
+    k(y+sy), k(x+sx, y+sy))`` with cells beyond the tile occupied (side 0)."""
+    t, s = occupied.shape[0], occupied.shape[1]
+    out = np.empty((t, 4, s, s), dtype=np.uint8)
+    for tile in range(t):
+        for q in range(4):
+            sx = -1 if q & 1 else 1
+            sy = -1 if q & 2 else 1
+            for j in range(s):
+                y = s - 1 - j if sy > 0 else j
+                for i in range(s):
+                    x = s - 1 - i if sx > 0 else i
+                    if occupied[tile, y, x]:
+                        out[tile, q, y, x] = 0
+                        continue
+                    xn, yn = x + sx, y + sy
+                    side = 0
+                    if 0 <= xn < s and 0 <= yn < s:
+                        side = min(out[tile, q, y, xn], out[tile, q, yn, x], out[tile, q, yn, xn])
+                    out[tile, q, y, x] = side + 1
+    return out

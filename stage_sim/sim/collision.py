@@ -92,6 +92,11 @@ class CollisionChecker:
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+        # The compiled clash test's hash table: 24 B per slot, over twice the colliding robots' points.
+        points = int(counts[collides].sum()) if len(collides) else 0
+        size = 1 << max(1, (2 * points - 1).bit_length())
+        self._table = (np.full(size, -1, dtype=np.int64), np.empty(size, dtype=np.int64),
+                       np.empty(max(points, 1), dtype=np.int64))
 
     def resolve(self, poses: np.ndarray, velocities: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Move every robot by one step; returns (new poses, refused) with refused moves undone.
@@ -162,7 +167,7 @@ class CollisionChecker:
         if self.grid.kernels == "numba":
             from stage_sim.sim.collision_kernels import owner_clashes
 
-            owner_clashes(cells, owner, conflict)
+            owner_clashes(cells, owner, *self._table, conflict)
             return conflict
         keep = cells >= 0
         robots = np.int64(len(poses))

@@ -30,26 +30,29 @@ def body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, w
 
 
 @numba.njit(**_JIT)
-def owner_clashes(cells, owner, conflict):
-    """Mark robots sharing a cell (-1: off the grid, ignored): an open-addressing table of the cells seen,
-    with the first robot seen in each; a later point of another robot there flags both. Memory: 16 B per
-    table entry, twice the points (the numpy reference sorts (cell, robot) pairs instead)."""
-    size = 2
-    while size < 2 * cells.size:
-        size <<= 1
-    mask = size - 1
-    keys = np.full(size, -1, dtype=np.int64)
-    robot = np.empty(size, dtype=np.int64)
+def owner_clashes(cells, owner, keys, robot, used, conflict):
+    """Mark robots sharing a cell (-1: off the grid, ignored) in an open-addressing table of the cells seen
+    (``keys``, all -1, a power of two over twice the points; ``robot`` the first robot seen in each; ``used``
+    room for a slot per point): a later point of another robot in a cell flags both. The table is left
+    empty again. The numpy reference sorts (cell, robot) pairs instead."""
+    mask = keys.size - 1
+    m = 0
+    last_cell = last_owner = -1
     for i in range(cells.size):
         cell = cells[i]
-        if cell < 0:
+        if cell < 0 or (cell == last_cell and owner[i] == last_owner):
             continue
+        last_cell, last_owner = cell, owner[i]
         slot = ((cell * 2654435761) >> 7) & mask
         while keys[slot] != -1 and keys[slot] != cell:
             slot = (slot + 1) & mask
         if keys[slot] == -1:
             keys[slot] = cell
             robot[slot] = owner[i]
+            used[m] = slot
+            m += 1
         elif robot[slot] != owner[i]:
             conflict[robot[slot]] = True
             conflict[owner[i]] = True
+    for j in range(m):
+        keys[used[j]] = -1
