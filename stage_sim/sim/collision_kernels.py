@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
