@@ -27,7 +27,7 @@ import numpy as np
 
 from stage_sim.maps.body_geometry import body_frame, body_shape, global_poses, transform_points
 from stage_sim.maps.polygon_raster import edge_cells, fill_cells, vertex_cells
-from stage_sim.maps.tiles import DENSE_CELL_LIMIT, CellValues, TileGrid, TileLayer, WorldTooLargeError
+from stage_sim.maps.tiles import DENSE_CELL_LIMIT, CellValues, TileGrid, TileLayer, WorldTooLargeError, unique_sorted
 from stage_sim.worldfile.description import Model, WorldDescription
 from stage_sim.worldfile.occupancy import FREE, OCCUPIED, OccupancyGrid
 
@@ -60,7 +60,7 @@ class StaticBody:
             raise WorldTooLargeError(
                 f"the filled footprint of {self.name!r} spans {span[0]:.0f} x {span[1]:.0f} cells (the limit of a "
                 f"map is {DENSE_CELL_LIMIT / 1e6:.0f} M cells): use a coarser resolution")
-        return np.union1d(self.outline, fill_cells(self.polygons, resolution, origin, shape))
+        return unique_sorted(np.concatenate([self.outline, fill_cells(self.polygons, resolution, origin, shape)]))
 
 
 @dataclass
@@ -83,25 +83,34 @@ class StaticRaster:
         return TileGrid.build(self.shape, self.resolution, self.origin_xy, blocks)
 
     def sensing_tiles(self, height: float) -> tuple[TileLayer, CellValues]:
-        """The cells rays at ``height`` hit, in tiles, and their intensity (a later body over an earlier one)."""
-        seen = [body for body in self.bodies if body.ranger_return >= 0 and body.z[0] <= height <= body.z[1]]
-        flat = np.concatenate([body.outline for body in seen] or [np.zeros(0, dtype=np.int64)])
-        values = np.concatenate([np.full(body.outline.size, body.ranger_return) for body in seen] or [np.zeros(0)])
-        intensity = CellValues.last_wins(flat, values)
-        return TileLayer.from_cells(self.grid, intensity.cells), intensity
+        """The cells rays at ``height`` hit, in tiles, and their intensity (a later body over an earlier one).
+
+        Heights that see the same bodies get the very same objects (one caster serves them all)."""
+        seen = tuple(i for i, body in enumerate(self.bodies)
+                     if body.ranger_return >= 0 and body.z[0] <= height <= body.z[1])
+        key = ("sense", seen)
+        if key not in self._cache:
+            bodies = [self.bodies[i] for i in seen]
+            flat = np.concatenate([body.outline for body in bodies] or [np.zeros(0, dtype=np.int64)])
+            values = np.concatenate([np.full(body.outline.size, body.ranger_return) for body in bodies]
+                                    or [np.zeros(0)])
+            layer = TileLayer.from_cells(self.grid, unique_sorted(flat))
+            self._cache[key] = (layer, CellValues.last_wins(flat, values))
+        return self._cache[key]
 
     def collision_tiles(self, z_low: float, z_high: float) -> TileLayer:
         """The cells that block a body spanning [z_low, z_high], in tiles."""
         flat = [body.outline for body in self.bodies
                 if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low]
-        return TileLayer.from_cells(self.grid, np.unique(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
+        return TileLayer.from_cells(self.grid, unique_sorted(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
 
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
         """(occupied, intensity) dense grids for rays at ``height`` (a picture: small worlds only)."""
         self.grid.check_dense("a dense sensing layer")
         layer, intensity = self.sensing_tiles(height)
         values = np.zeros(self.shape[0] * self.shape[1], dtype=np.float32)
-        values[intensity.cells] = intensity.values
+        cells = layer.cells()
+        values[cells] = intensity.at(cells)
         return layer.dense(), values.reshape(self.shape)
 
     def collision_layer(self, z_low: float, z_high: float) -> np.ndarray:
@@ -155,7 +164,7 @@ def build_static_raster(
     for _, members in groupby(zip(shapes, outlines, strict=True), key=lambda item: (id(item[0].model), item[0].group)):
         parts = list(members)
         shape_of, cells = parts[0][0], np.concatenate([cells for _, cells in parts]) - low
-        outline = np.unique(cells[:, 1] * shape[1] + cells[:, 0])
+        outline = unique_sorted(cells[:, 1] * shape[1] + cells[:, 0])
         model = shape_of.model
         bodies.append(StaticBody(model.name, outline, shape_of.z, model.ranger_return, model.obstacle_return,
                                  [part.points for part, _ in parts], frame))

@@ -12,14 +12,14 @@ What it costs:
 
 * :class:`TileGrid` — the slot index, int32 per region: 4 B per 1024 cells of the bounding box
   (a 1 km × 1 km world at 0.01 m: 9.8 M regions, 39 MB; 30 m × 30 m at 0.001 m: 3.5 MB);
-* :class:`TileLayer` — 4 B per slot (which tile) plus 1 KB per tile (a bool per cell);
-* :class:`CellValues` — 12 B per cell it holds (sorted int64 cell, float32 value).
+* :class:`TileLayer` — 4 B per slot (which tile) plus 128 B per tile (a bit per cell);
+* :class:`CellValues` — 12 B per cell it holds (sorted int64 cell, float32 value), nothing when every cell
+  holds the same value.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
@@ -28,6 +28,15 @@ TILE_BITS = 5
 TILE = 1 << TILE_BITS
 #: Largest virtual grid a dense copy (a picture, ``/map``, a distance transform) is made of.
 DENSE_CELL_LIMIT = 64_000_000
+
+
+def unique_sorted(values: np.ndarray) -> np.ndarray:
+    """Sorted distinct integers of ``values``: ``np.unique`` by a sort (numpy 2.4's hashing ``np.unique``
+    is some 50 times slower on the million-cell outlines of a large floorplan)."""
+    ordered = np.sort(np.asarray(values).ravel())
+    keep = np.ones(ordered.size, dtype=bool)
+    keep[1:] = ordered[1:] != ordered[:-1]
+    return ordered[keep]
 
 
 class WorldTooLargeError(ValueError):
@@ -57,7 +66,7 @@ class TileGrid:
         slots = np.full(regions, -1, dtype=np.int32)
         grid = cls((int(h), int(w)), col0, row0, rcol0, rrow0, slots)
         rr, rc, _, _ = grid.locate(np.asarray(blocks, dtype=np.int64))
-        used = np.unique(rr * regions[1] + rc)
+        used = unique_sorted(rr * regions[1] + rc)
         slots.ravel()[used] = np.arange(used.size, dtype=np.int32)
         return grid
 
@@ -88,23 +97,29 @@ class TileGrid:
 
 @dataclass(frozen=True)
 class TileLayer:
-    """A set of cells of a :class:`TileGrid`: a tile of bools for each slot the set has a cell in."""
+    """A set of cells of a :class:`TileGrid`: a tile of bits for each slot the set has a cell in."""
 
     grid: TileGrid
     tile_of_slot: np.ndarray  #: (S,) int32: the layer's tile of each slot, −1 where it has no cell
-    occupied: np.ndarray  #: (T, TILE, TILE) bool, [tile, row in tile, col in tile]
+    bits: np.ndarray  #: (T, TILE, TILE / 8) uint8, [tile, row in tile, col in tile / 8], bit col % 8
 
     @classmethod
     def from_cells(cls, grid: TileGrid, flat: np.ndarray) -> TileLayer:
         """The layer of flat grid cells ``flat`` (every one in a region holding a block of ``grid``)."""
         rr, rc, ty, tx = grid.locate(np.asarray(flat, dtype=np.int64))
         slot = grid.slots[rr, rc]
-        used, tile = np.unique(slot, return_inverse=True)
+        used = unique_sorted(slot)
+        tile = np.searchsorted(used, slot)
         tile_of_slot = np.full(grid.slot_count, -1, dtype=np.int32)
         tile_of_slot[used] = np.arange(used.size, dtype=np.int32)
         occupied = np.zeros((used.size, TILE, TILE), dtype=bool)
         occupied[tile, ty, tx] = True
-        return cls(grid, tile_of_slot, occupied)
+        return cls(grid, tile_of_slot, np.packbits(occupied, axis=-1, bitorder="little"))
+
+    @property
+    def occupied(self) -> np.ndarray:
+        """(T, TILE, TILE) bool: the tiles unpacked, [tile, row in tile, col in tile]."""
+        return np.unpackbits(self.bits, axis=-1, bitorder="little").astype(bool)
 
     def contains(self, flat: np.ndarray) -> np.ndarray:
         """Whether each flat grid cell is in the layer (−1, off the grid, is not)."""
@@ -116,7 +131,7 @@ class TileLayer:
         tile = np.where(slot >= 0, self.tile_of_slot[slot], -1)
         found = tile >= 0
         hits = np.zeros(tile.shape, dtype=bool)
-        hits[found] = self.occupied[tile[found], ty[found], tx[found]]
+        hits[found] = (self.bits[tile[found], ty[found], tx[found] >> 3] >> (tx[found] & 7)) & 1
         out[on] = hits
         return out
 
@@ -144,29 +159,27 @@ class TileLayer:
 
 @dataclass(frozen=True)
 class CellValues:
-    """A value for each of a set of flat cells (the intensity of the cells a ray can hit), 0 elsewhere."""
+    """A value for each of a set of flat cells (the intensity of the cells a ray can hit)."""
 
-    cells: np.ndarray  #: sorted unique int64 flat cells
-    values: np.ndarray  #: float32, one per cell
+    cells: np.ndarray  #: sorted unique int64 flat cells (empty when every cell holds ``values[0]``)
+    values: np.ndarray  #: float32, one per cell (one for all)
 
     @classmethod
     def last_wins(cls, flat: np.ndarray, values: np.ndarray) -> CellValues:
         """Cells with their value, the last entry of a cell listed twice winning (as a painter's overwrite)."""
+        values = np.asarray(values, dtype=np.float32)
+        if values.size == 0 or np.all(values == values[0]):
+            return cls(np.zeros(0, dtype=np.int64), values[:1])
         flat = np.asarray(flat, dtype=np.int64)
         order = np.argsort(flat, kind="stable")
-        flat, values = flat[order], np.asarray(values, dtype=np.float32)[order]
+        flat, values = flat[order], values[order]
         last = np.ones(flat.size, dtype=bool)
         last[:-1] = flat[1:] != flat[:-1]
         return cls(flat[last], values[last])
 
-    @cached_property
-    def uniform(self) -> bool:
-        """Whether every cell holds the same value (the common case: one ``ranger_return`` for all)."""
-        return bool(np.all(self.values == self.values[0])) if self.values.size else True
-
     def at(self, flat: np.ndarray) -> np.ndarray:
         """The value of each of the flat cells ``flat``, every one of them in the set (a ray's static hit)."""
         flat = np.asarray(flat, dtype=np.int64)
-        if self.uniform:
+        if self.cells.size == 0:
             return np.full(flat.shape, self.values[0] if self.values.size else 0.0, dtype=np.float32)
         return self.values[np.searchsorted(self.cells, flat)]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stage_sim.maps.polygon_raster import point_cells
-from stage_sim.maps.tiles import TileLayer
+from stage_sim.maps.tiles import TileLayer, unique_sorted
 from stage_sim.sim.kinematics import integrate
 
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
@@ -171,7 +171,7 @@ class CollisionChecker:
             return conflict
         keep = cells >= 0
         robots = np.int64(len(poses))
-        pairs = np.unique(cells[keep] * robots + owner[keep])  # each (cell, robot) once, by cell
+        pairs = unique_sorted(cells[keep] * robots + owner[keep])  # each (cell, robot) once, by cell
         shared = pairs[1:] // robots == pairs[:-1] // robots
         conflict[pairs[1:][shared] % robots] = True
         conflict[pairs[:-1][shared] % robots] = True

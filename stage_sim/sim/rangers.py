@@ -204,10 +204,13 @@ class RangerSensing:
     ) -> list:
         groups = []
         returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
+        casters: dict[int, GridRayCaster | NumbaRayCaster] = {}  # heights that see the same static cells share one
         for height in np.unique(ray_height):
             occupied, intensity = static.sensing_tiles(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
-            caster = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
+            if id(occupied) not in casters:
+                casters[id(occupied)] = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
+            caster = casters[id(occupied)]
             rays = np.flatnonzero(ray_height == height)
             groups.append(_HeightGroup(
                 rays=rays,
