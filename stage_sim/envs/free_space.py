@@ -27,6 +27,7 @@ class FreeSpace:
 
     def __init__(self, sim: Simulation, robots: list[int], margin: float) -> None:
         static = sim.static
+        static.grid.check_dense("placing robots in free space (a distance transform of the whole world)")
         blocked = np.zeros(static.shape, dtype=bool)
         for band in {sim.robots[i].z_band for i in robots}:
             blocked |= static.collision_layer(*band)

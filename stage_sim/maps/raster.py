@@ -128,6 +128,19 @@ class StaticRaster:
             self._cache["any"] = occupied.reshape(self.shape)
         return self._cache["any"]
 
+    def map_labels(self, max_cells: int = DENSE_CELL_LIMIT) -> tuple[np.ndarray, int]:
+        """A picture of the static world: per pixel 0 (free) or k (the k-th body, later bodies on top), and
+        how many cells a pixel side spans. One pixel per cell with the filled footprints when the grid has at
+        most ``max_cells`` cells; else one pixel per ``step`` × ``step`` cells holding any outline cell (the
+        filled footprint of a world that large is never made)."""
+        h, w = self.shape
+        step = 1 if h * w <= max_cells else int(np.ceil(np.sqrt(h * w / max_cells)))
+        labels = np.zeros((-(-h // step), -(-w // step)), dtype=np.int32)
+        for k, body in enumerate(self.bodies, start=1):
+            rows, cols = np.divmod(body.cells if step == 1 else body.outline, w)
+            labels[rows // step, cols // step] = k
+        return labels, step
+
     @property
     def occupied_cell_count(self) -> int:
         """How many cells the filled footprints cover."""

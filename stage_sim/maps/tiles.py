@@ -128,7 +128,8 @@ class TileLayer:
         on = flat >= 0
         rr, rc, ty, tx = self.grid.locate(flat[on])
         slot = self.grid.slots[rr, rc]
-        tile = np.where(slot >= 0, self.tile_of_slot[slot], -1)
+        tile = np.full(slot.shape, -1, dtype=np.int64)
+        tile[slot >= 0] = self.tile_of_slot[slot[slot >= 0]]
         found = tile >= 0
         hits = np.zeros(tile.shape, dtype=bool)
         hits[found] = (self.bits[tile[found], ty[found], tx[found] >> 3] >> (tx[found] & 7)) & 1

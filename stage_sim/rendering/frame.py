@@ -243,10 +243,9 @@ def _static_labels(sim: Simulation) -> tuple[np.ndarray, list[palette.RGB]]:
     for model in sim.description.walk():
         color_of.setdefault(model.name, model.color)
     static = sim.static
-    labels = np.zeros(static.shape[0] * static.shape[1], dtype=np.int32)
-    for k, body in enumerate(static.bodies, start=1):
-        labels[body.cells] = k
-    return labels.reshape(static.shape), [palette.blend(color_of[body.name]) for body in static.bodies]
+    static.grid.check_dense("a picture of the world")
+    labels, _ = static.map_labels()
+    return labels, [palette.blend(color_of[body.name]) for body in static.bodies]
 
 
 def _robot_drawings(sim: Simulation) -> list[_Robot]:

@@ -10,8 +10,11 @@ import math
 
 import numpy as np
 
+from stage_sim.maps.tiles import DENSE_CELL_LIMIT
 from stage_sim.sim.simulation import Simulation
 
+#: Most coarse cells of a coverage grid (one per robot): a larger world is covered in coarser cells.
+COVERAGE_CELL_LIMIT = 4_000_000
 # A robot stands still while it stays this close to one pose (m, rad): dithering between tiny turns or
 # creeping back and forth is standing still too, not just a zero velocity.
 STOP_RADIUS, STOP_TURN = 0.05, 0.1
@@ -21,7 +24,8 @@ class RunStats:
     """Per-robot distance, stall events, longest stop and coverage, from the ground truth of every step.
 
     A stop lasts from a pose until the robot first gets STOP_RADIUS or STOP_TURN away from it. Coverage is
-    the share of the map's free cells (``cell`` m squares whose fine cells are all free, 4-connected
+    the share of the map's free cells (``cell`` m squares, coarser in a world of over
+    :data:`COVERAGE_CELL_LIMIT` of them, whose fine cells are all free, 4-connected
     to a robot's start) that came within ``radius`` of the robot: a disc is stamped on a coarse grid wherever
     the robot enters a new cell.
     """
@@ -29,13 +33,18 @@ class RunStats:
     def __init__(self, sim: Simulation, cell: float = 0.1, radius: float = 1.0) -> None:
         self.sim = sim
         static = sim.static
-        factor = max(1, round(cell / static.resolution))
+        height, width = static.shape
+        factor = max(1, round(cell / static.resolution), math.ceil(math.sqrt(height * width / COVERAGE_CELL_LIMIT)))
         self.cell = factor * static.resolution
         self.origin = np.array(static.origin_xy, dtype=np.float64)
-        rows, cols = (n // factor for n in static.shape)
-        fine = static.occupied[: rows * factor, : cols * factor].reshape(rows, factor, cols, factor)
+        rows, cols = height // factor, width // factor
+        blocked = np.zeros((rows, cols), dtype=bool)  # a coarse cell holding any occupied fine cell
+        for body in static.bodies:  # the filled footprints; only the outlines of a world too large for them
+            r, c = np.divmod(body.cells if height * width <= DENSE_CELL_LIMIT else body.outline, width)
+            keep = (r < rows * factor) & (c < cols * factor)
+            blocked[r[keep] // factor, c[keep] // factor] = True
         starts = [self._cell_of(pose) for pose in sim.true_poses]
-        self.free = _connected(~fine.any(axis=(1, 3)), starts)
+        self.free = _connected(~blocked, starts)
         reach = math.ceil(radius / self.cell)
         offsets = np.arange(-reach, reach + 1)
         self._disc = np.hypot(*np.meshgrid(offsets, offsets, indexing="ij")) * self.cell <= radius

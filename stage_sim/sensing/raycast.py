@@ -157,7 +157,9 @@ class GridRayCaster:
             robot_tile[inside] = regions[rr[inside], rc[inside]]
         full = (slot >= 0) | (robot_tile != -1)
         enter = rows[full]
-        si[_TILE, enter] = np.where(slot[full] >= 0, self._tile_of_slot[slot[full]], -1)
+        static = enter[slot[full] >= 0]
+        si[_TILE, enter] = -1
+        si[_TILE, static] = self._tile_of_slot[slot[slot >= 0]]
         si[_RTILE, enter] = robot_tile[full]
         si[_CALC, enter] = 1
         si[_IN, enter] = 1

@@ -46,16 +46,17 @@ class Scene:
         rows, cols = static.shape
         x0, y0 = static.origin_xy
         bounds = (x0, y0, x0 + cols * static.resolution, y0 + rows * static.resolution)
+        png, step = _map_png(sim)
         description = {
             "type": "scene",
             "world": sim.description.path.name if sim.description.path else "",
             "bounds": list(bounds),
-            "map": {"url": "map.png", "origin": [x0, y0], "resolution": static.resolution},
+            "map": {"url": "map.png", "origin": [x0, y0], "resolution": static.resolution * step},
             "interval": sim.interval,
             "readonly": readonly,
             "robots": [_robot(sim, i, name) for i, name in enumerate(names)],
         }
-        return cls(description, _map_png(sim), bounds)
+        return cls(description, png, bounds)
 
 
 def css_color(rgba: tuple[float, float, float, float]) -> str:
@@ -92,18 +93,18 @@ def _robot(sim: Simulation, index: int, name: str) -> dict[str, Any]:
     }
 
 
-def _map_png(sim: Simulation) -> bytes:
-    """One pixel per static raster cell, row 0 at the top (largest y), in its model's colour."""
+def _map_png(sim: Simulation) -> tuple[bytes, int]:
+    """The static world as a PNG, row 0 at the top (largest y), in its models' colours, and the cells a pixel
+    spans: one pixel per raster cell, or fewer for a world too large for that
+    (:meth:`~stage_sim.maps.raster.StaticRaster.map_labels`)."""
     from PIL import Image
 
     static = sim.static
     colors = {model.name: model.color for model in reversed(list(sim.description.walk()))}
-    rgb = np.empty((static.shape[0] * static.shape[1], 3), dtype=np.uint8)
-    rgb[:] = FREE_RGB
-    for body in static.bodies:
-        hexa = css_color(colors.get(body.name, (0.0, 0.0, 0.0, 1.0)))
-        rgb[body.cells] = [int(hexa[i:i + 2], 16) for i in (1, 3, 5)]
-    image = Image.fromarray(rgb.reshape(*static.shape, 3)[::-1])
+    labels, step = static.map_labels()
+    hexas = [css_color(colors.get(body.name, (0.0, 0.0, 0.0, 1.0))) for body in static.bodies]
+    palette = np.array([FREE_RGB, *([int(h[i:i + 2], 16) for i in (1, 3, 5)] for h in hexas)], dtype=np.uint8)
+    image = Image.fromarray(palette[labels[::-1]])
     buffer = io.BytesIO()
     image.save(buffer, format="PNG")
-    return buffer.getvalue()
+    return buffer.getvalue(), step
