@@ -14,7 +14,12 @@ an edge merely touches is occupied and the inside of a thick obstacle is empty, 
 filled layer (:attr:`StaticBody.cells`: outline plus the cells whose centre is inside) is what a map of
 the world shows (``/map``, pictures, coverage statistics); it never changes a scan or a collision.
 
-The grid's cells are Stage's cells: its origin is a whole number of cells from the world origin.
+The grid's cells are Stage's cells: its origin is a whole number of cells from the world origin. The grid
+is virtual (the bounding box of the static world and the robots' start discs): nothing is allocated per
+cell of it. Each body keeps the sorted flat indices of its outline cells (8 B per cell); the layers the
+simulation asks for are built from them straight into tiles of 32 × 32 cells where a layer has a cell
+(:mod:`stage_sim.maps.tiles`: 4 B per 1024 cells of the box for the region index, 128 B per tile and
+layer). The filled footprints are made only when a map is asked for.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Child processes for the corpus tests: a memory limit, a wall timeout and the CPU time they used.
 
-Some real worlds (Stage's SFU.world, large.world) make a dense raster of tens of GB until issue #14's
-sparse world lands; they run in a child whose address space is capped, so they fail there, never take
-the machine down, and never leave pytest itself short of memory.
+Every world runs in a child whose address space is capped, so that a world that would grow without
+bound (as Stage's SFU.world and large.world did before the sparse world) fails there, never takes the
+machine down, and never leaves pytest itself short of memory.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ def test_the_corpus_is_there() -> None:
     require_corpus()
 
 
-@pytest.mark.parametrize("world", params(rasterises=False))
+@pytest.mark.parametrize("world", params())
 def test_inspect_loads_or_stops_with_a_located_message(world: World) -> None:
     run = run_limited(python_command("-m", "stage_sim.cli", "inspect", "--json", str(world.path)))
     assert run.returncode is not None, f"inspect still running after its wall timeout: {run.stderr[-500:]}"
