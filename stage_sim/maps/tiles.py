@@ -19,7 +19,7 @@ What it costs:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -102,6 +102,8 @@ class TileLayer:
     grid: TileGrid
     tile_of_slot: np.ndarray  #: (S,) int32: the layer's tile of each slot, −1 where it has no cell
     bits: np.ndarray  #: (T, TILE, TILE / 8) uint8, [tile, row in tile, col in tile / 8], bit col % 8
+    derived: dict = field(default_factory=dict, compare=False, repr=False)
+    """What users compute from the layer once for all (the ray casters' free squares)."""
 
     @classmethod
     def from_cells(cls, grid: TileGrid, flat: np.ndarray) -> TileLayer:

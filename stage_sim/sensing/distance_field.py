@@ -9,8 +9,8 @@ looks at the next region afresh. A ray moving towards that quadrant cannot leave
 travelled ``k`` cells along one axis, wherever it starts inside ``c``.
 
 Computed by the classic "largest square" recurrence ``k(c) = 1 + min(k(c+x), k(c+y), k(c+x+y))``, one row
-of every tile at a time (the row recurrence is a reversed running minimum, so a row is a handful of numpy
-calls for all tiles and quadrants together). Static tiles: 32 × 32 cells, 4 KB per tile (uint8 per cell
+of every tile at a time (the row recurrence is a running minimum, so a row is a handful of numpy calls for
+many tiles and all quadrants together). Static tiles: 32 × 32 cells, 4 KB per tile (uint8 per cell
 and quadrant); robot block tiles: 4 × 4 blocks, 64 B.
 """
 
@@ -22,27 +22,40 @@ import numpy as np
 SQUARE_CAP = 255
 
 
+#: Tiles per numpy pass (bounds the temporaries to a few tens of MB).
+CHUNK_TILES = 4096
+
+
 def tile_square_fields(occupied: np.ndarray) -> np.ndarray:
     """(T, 4, S, S) uint8 square sides of tiles ``occupied`` (T, S, S) bool, ``[tile, q, row, col]``."""
     occ = np.asarray(occupied, dtype=bool)
+    out = np.empty((occ.shape[0], 4, occ.shape[1], occ.shape[2]), dtype=np.uint8)
+    for start in range(0, occ.shape[0], CHUNK_TILES):
+        out[start:start + CHUNK_TILES] = _chunk_fields(occ[start:start + CHUNK_TILES])
+    return out
+
+
+def _chunk_fields(occ: np.ndarray) -> np.ndarray:
     t, s = occ.shape[0], occ.shape[1]
-    # Every quadrant turned to extend towards +x / +y: mirrored in x when sx < 0, in y when sy < 0.
-    flipped = np.stack([occ, occ[:, :, ::-1], occ[:, ::-1, :], occ[:, ::-1, ::-1]], axis=1).reshape(4 * t, s, s)
+    # Every quadrant turned so that its squares extend towards lower indices (mirrored in x when sx > 0, in
+    # y when sy > 0): rows are then swept upwards and each row's recurrence is a forward running minimum.
+    turned = np.stack([occ[:, ::-1, ::-1], occ[:, ::-1, :], occ[:, :, ::-1], occ], axis=1).reshape(4 * t, s, s)
     out = np.empty((4 * t, s, s), dtype=np.uint8)
-    col = np.arange(s + 1, dtype=np.int32)
-    # prev: sides of the row above (y + 1); one extra column, beyond the tile: occupied (side 0).
+    x = np.arange(-1, s, dtype=np.int32)  # column 0 of the work rows: beyond the tile, occupied (side 0)
     prev = np.zeros((4 * t, s + 1), dtype=np.int32)
     cand = np.empty((4 * t, s + 1), dtype=np.int32)
-    cand[:, s] = s
-    for y in range(s - 1, -1, -1):
-        # Free cell: k(x) = 1 + min(m(x), k(x+1)) with m(x) = min(k_above(x), k_above(x+1)); an
-        # occupied cell has k = 0. Unrolled, k(x) = min_{x' >= x} cand(x') - x with
-        # cand(x') = x' (occupied) or m(x') + 1 + x' (free): a reversed running minimum.
-        np.minimum(prev[:, :s], prev[:, 1:], out=cand[:, :s])
-        cand[:, :s] += col[:s] + 1
-        np.copyto(cand[:, :s], col[:s], where=flipped[:, y])
-        prev = np.minimum.accumulate(cand[:, ::-1], axis=1)[:, ::-1] - col
-        out[:, y] = prev[:, :s]
+    for y in range(s):
+        # Free cell: k(x) = 1 + min(m(x), k(x-1)) with m(x) = min(k_below(x), k_below(x-1)); an occupied cell
+        # has k = 0. Unrolled, k(x) = x + min_{x' <= x} (cand(x') - x') with cand(x') = 0 (occupied) or
+        # m(x') + 1 (free): a running minimum.
+        np.minimum(prev[:, 1:], prev[:, :-1], out=cand[:, 1:])
+        cand[:, 1:] += 1
+        np.copyto(cand[:, 1:], 0, where=turned[:, y])
+        cand[:, 0] = 0
+        cand -= x
+        np.minimum.accumulate(cand, axis=1, out=cand)
+        cand += x
+        out[:, y] = cand[:, 1:]
+        prev, cand = cand, prev
     out = out.reshape(t, 4, s, s)
-    return np.ascontiguousarray(np.stack(
-        [out[:, 0], out[:, 1, :, ::-1], out[:, 2, ::-1, :], out[:, 3, ::-1, ::-1]], axis=1))
+    return np.stack([out[:, 0, ::-1, ::-1], out[:, 1, ::-1, :], out[:, 2, :, ::-1], out[:, 3]], axis=1)

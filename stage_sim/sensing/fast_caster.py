@@ -18,7 +18,7 @@ from stage_sim.sensing import traversal
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import beam_cos_sin, ray_arguments, static_layer
+from stage_sim.sensing.stage_walk import beam_cos_sin, free_squares, ray_arguments, static_layer
 
 
 class NumbaRayCaster:
@@ -40,7 +40,7 @@ class NumbaRayCaster:
         self.height, self.width = layer.grid.shape
         self.threads = threads
         self._grid = layer.grid
-        self._world = (traversal.tile_square_fields(layer.occupied), layer.tile_of_slot, layer.grid.slots)
+        self._world = (free_squares(layer, traversal.tile_square_fields), layer.tile_of_slot, layer.grid.slots)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
                            np.full((1, 1, 1), -1, dtype=np.int32), np.zeros((1, 1, 1, 1), dtype=np.uint8))

@@ -41,7 +41,15 @@ import numpy as np
 from stage_sim.maps.tiles import TileGrid, TileLayer
 from stage_sim.sensing.distance_field import SQUARE_CAP, tile_square_fields
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import REGION, REGION_BITS, WalkRays, finish_ranges, ray_arguments, static_layer
+from stage_sim.sensing.stage_walk import (
+    REGION,
+    REGION_BITS,
+    WalkRays,
+    finish_ranges,
+    free_squares,
+    ray_arguments,
+    static_layer,
+)
 
 # Rows of the integer state (_TILE: static tile of the region the walk is in, _RTILE: its robot tile).
 _ID, _KX, _KY, _E, _N, _SX, _SY, _BX, _BY, _Q, _IN, _CX, _CY, _R, _C, _CALC, _OWN, _XMAJ, _TILE, _RTILE = range(20)
@@ -91,7 +99,7 @@ class GridRayCaster:
         self.height, self.width = layer.grid.shape
         self._grid = layer.grid
         self._tile_of_slot = layer.tile_of_slot
-        self._squares = tile_square_fields(layer.occupied)
+        self._squares = free_squares(layer, tile_square_fields)
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
