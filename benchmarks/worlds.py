@@ -1,6 +1,7 @@
 """Large worlds in bounded memory: load time, peak RSS and speed of the two big worlds of issue #14.
 
-Run with the venv's python: ``.venv/bin/python benchmarks/worlds.py [--worlds floorplan rl] [--seconds S]``.
+Run with the venv's python: ``.venv/bin/python benchmarks/worlds.py [--worlds floorplan rl] [--seconds S]
+[--kernels numba|numpy]``.
 Each world runs in its own process (so that each peak RSS is its own) and prints one JSON line: world,
 cells (H, W of the world's bounding box), robots, beams, load_s (world file → ready ``Simulation``, kernels
 cached; ``import_s`` before it: Python, numpy, numba and stage_sim), steps, realtime_factor, ms_per_step,
@@ -132,7 +133,7 @@ def world_text(name: str, folder: Path) -> str:
     return RL.format(bitmap=folder / "rl_map.png", robot=folder / "robot.png") + robots
 
 
-def measure(name: str, seconds: float) -> dict:
+def measure(name: str, seconds: float, kernels: str) -> dict:
     """Load the world, drive every robot in a circle for ``seconds`` of sim time, report."""
     from stage_sim.sensing.kernels import numba_available
     from stage_sim.sim.simulation import Simulation
@@ -143,7 +144,8 @@ def measure(name: str, seconds: float) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         text = world_text(name, Path(folder))
         begin = time.perf_counter()
-        sim = Simulation(load_world_text(text, str(Path(folder) / f"{name}.world")), seed=1, threads=1)
+        sim = Simulation(load_world_text(text, str(Path(folder) / f"{name}.world")), seed=1, kernels=kernels,
+                         threads=1)
         load = time.perf_counter() - begin
     for i in range(len(sim.robots)):
         sim.set_velocity(i, 0.3, 0.0, 0.5)
@@ -173,13 +175,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--worlds", nargs="+", choices=("floorplan", "rl"), default=["floorplan", "rl"])
     parser.add_argument("--seconds", type=float, default=10.0, help="sim seconds per world")
+    parser.add_argument("--kernels", choices=("numba", "numpy"), default="numba")
     parser.add_argument("--child", choices=("floorplan", "rl"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        print(json.dumps(measure(args.child, args.seconds)), flush=True)
+        print(json.dumps(measure(args.child, args.seconds, args.kernels)), flush=True)
         return
     for name in args.worlds:
-        subprocess.run([sys.executable, __file__, "--child", name, "--seconds", str(args.seconds)], check=True)
+        subprocess.run([sys.executable, __file__, "--child", name, "--seconds", str(args.seconds), "--kernels",
+                        args.kernels], check=True)
 
 
 if __name__ == "__main__":
