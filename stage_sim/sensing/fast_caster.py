@@ -15,10 +15,15 @@ import numpy as np
 
 from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing import traversal
+from stage_sim.sensing.distance_field import tile_square_fields
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sensing.stage_walk import beam_cos_sin, free_squares, ray_arguments, static_layer
+
+
+#: Static tiles up to which the free squares are computed by numpy (about 0.1 s).
+NUMPY_SQUARE_TILES = 2048
 
 
 class NumbaRayCaster:
@@ -33,14 +38,17 @@ class NumbaRayCaster:
                  threads: int = 1, blocks: np.ndarray | None = None):
         if not resolution > 0:
             raise ValueError("resolution must be positive")
-        announce_compilation(traversal.cast_serial, traversal.tile_square_fields)
+        announce_compilation(traversal.cast_serial)
         layer = static_layer(occupied, resolution, origin_xy, blocks)
         self.resolution = float(resolution)
         self.origin_xy = (float(origin_xy[0]), float(origin_xy[1]))
         self.height, self.width = layer.grid.shape
         self.threads = threads
         self._grid = layer.grid
-        self._world = (free_squares(layer, traversal.tile_square_fields), layer.tile_of_slot, layer.grid.slots)
+        # numpy computes the squares of an ordinary world as fast as loading the compiled function would take
+        # (and without its few MB); a large world's are computed compiled (identical fields)
+        compute = traversal.tile_square_fields if layer.bits.shape[0] > NUMPY_SQUARE_TILES else tile_square_fields
+        self._world = (free_squares(layer, compute), layer.tile_of_slot, layer.grid.slots)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
                            np.full((1, 1, 1), -1, dtype=np.int32), np.zeros((1, 1, 1, 1), dtype=np.uint8))
