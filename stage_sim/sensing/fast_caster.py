@@ -21,7 +21,6 @@ from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sensing.stage_walk import beam_cos_sin, free_squares, ray_arguments, static_layer
 
-
 #: Static tiles up to which the free squares are computed by numpy (about 0.1 s).
 NUMPY_SQUARE_TILES = 2048
 

@@ -66,6 +66,7 @@ class RobotLayer:
         """``compiled``: update with the numba kernels (:mod:`stage_sim.sensing.robot_kernels`), same result."""
         self.grid = grid
         self.compiled = compiled
+        self._place = np.append(grid.place, grid.shape[0])
         self.shape = grid.shape
         #: (R, C) int32 per region: its robot tile, :data:`MARKED`, or -1 (no robot cell there)
         self.regions = np.full(grid.slots.shape, -1, dtype=np.int32)
@@ -115,10 +116,9 @@ class RobotLayer:
         rows = np.asarray(cell_rows, dtype=np.int64).ravel()
         ids = np.asarray(robot_ids, dtype=np.int64).ravel()
         seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
-        place = np.append(self.grid.place, self.shape[0])
         self._marked, tile, local, count = robot_kernels.number_robot_regions(
-            self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(), ids, seen, place,
-            self.shape[1], MARKED)
+            self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(), ids, seen,
+            self._place, self.shape[1], MARKED)
         self._reserve(count)
         self.active = robot_kernels.write_robot_tiles(self.ids, self.blocks, tile, local, ids.astype(np.int32),
                                                       count, SEVERAL_ROBOTS, BLOCK)
@@ -133,6 +133,14 @@ class RobotLayer:
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
+        if self.compiled:  # the compiled numbering, with no robot seen: marks only
+            from stage_sim.sensing import robot_kernels
+
+            rows = np.asarray(cell_rows, dtype=np.int64).ravel()
+            self._marked = robot_kernels.number_robot_regions(
+                self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(),
+                np.zeros(rows.size, dtype=np.int64), np.zeros(1, dtype=bool), self._place, self.shape[1], MARKED)[0]
+            return
         flat_regions = self.regions.ravel()
         flat_regions[self._marked] = -1
         rows, cols, _ = visible_cells(cell_rows, cell_cols, np.zeros(np.size(cell_rows), dtype=np.int64), self.shape,

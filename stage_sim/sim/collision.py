@@ -152,8 +152,19 @@ class CollisionChecker:
         hit = np.zeros(len(cells), dtype=bool)
         for i, layer in enumerate(self._layers):
             use = (layer_index == i) & (cells >= 0)
-            hit[use] = layer.contains(cells[use])
+            hit[use] = self._contains(layer, cells[use])
         return (np.bincount(point_robot[hit], minlength=self.bodies.count) > 0)[movers]
+
+    def _contains(self, layer: TileLayer, cells: np.ndarray) -> np.ndarray:
+        """Whether each flat cell is in the static layer (the compiled lookup when the kernels are numba's)."""
+        if self.grid.kernels == "numpy":
+            return layer.contains(cells)
+        from stage_sim.sim.collision_kernels import layer_contains
+
+        out = np.empty(cells.size, dtype=bool)
+        grid = layer.grid
+        layer_contains(cells, grid.slots, layer.tile_of_slot, layer.bits, grid.place, grid.shape[1], out)
+        return out
 
     def _robot_conflicts(self, poses: np.ndarray) -> np.ndarray:
         """Robots whose bodies share a cell with another colliding robot at ``poses``."""

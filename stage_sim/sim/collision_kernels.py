@@ -10,6 +10,8 @@ import math
 
 import numba
 
+from stage_sim.maps.tiles import TILE, TILE_BITS
+
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
@@ -55,3 +57,24 @@ def owner_clashes(cells, owner, keys, robot, used, conflict):
             conflict[owner[i]] = True
     for j in range(m):
         keys[used[j]] = -1
+
+
+@numba.njit(**_JIT)
+def layer_contains(cells, slots, tile_of_slot, bits, place, width, out):
+    """``out[i]``: whether flat cell ``cells[i]`` (-1: off the grid) is in a
+    :class:`~stage_sim.maps.tiles.TileLayer` (its slots, tiles and bits; ``place``: col0, row0, rcol0,
+    rrow0), as :meth:`~stage_sim.maps.tiles.TileLayer.contains` says."""
+    col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
+    for i in range(cells.size):
+        out[i] = False
+        if cells[i] < 0:
+            continue
+        wy = cells[i] // width + row0
+        wx = cells[i] % width + col0
+        slot = slots[(wy >> TILE_BITS) - rrow0, (wx >> TILE_BITS) - rcol0]
+        if slot < 0:
+            continue
+        tile = tile_of_slot[slot]
+        if tile >= 0:
+            x = wx & (TILE - 1)
+            out[i] = (bits[tile, wy & (TILE - 1), x >> 3] >> (x & 7)) & 1 == 1
