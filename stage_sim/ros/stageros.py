@@ -32,6 +32,7 @@ from tf2_msgs.msg import TFMessage
 
 from stage_sim.bags import fields
 from stage_sim.bags.names import RobotNames, robot_names
+from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
 from stage_sim.ros.rival_publishers import RivalPublishers
 from stage_sim.sensing.kernels import resolve_threads
@@ -162,7 +163,11 @@ class StageRos(Node):
         edges = fields.static_edges(self.sim.robots, self.names)
         self.tf_static_pub.publish(TFMessage(transforms=[conversions.edge_transform(e, time) for e in edges]))
         if self.map_pub is not None:
-            grid = self.sim.static.to_occupancy_grid()
+            try:
+                grid = self.sim.static.to_occupancy_grid()
+            except WorldTooLargeError as error:  # the simulation runs on; only the picture is refused
+                self.get_logger().warning(f"not publishing /map: {error}")
+                return
             self.map_pub.publish(conversions.occupancy_grid_msg(grid, fields.WORLD_FRAME, time))
 
     # -- callbacks -----------------------------------------------------------------------------------------
