@@ -13,8 +13,9 @@ import numpy as np
 from stage_sim.maps.tiles import DENSE_CELL_LIMIT
 from stage_sim.sim.simulation import Simulation
 
-#: Most coarse cells of a coverage grid (one per robot): a larger world is covered in coarser cells.
-COVERAGE_CELL_LIMIT = 4_000_000
+#: Most coarse cells of a coverage grid (one per robot; the connected free space is grown by dilation, which
+#: costs side × cells): a larger world is covered in coarser cells.
+COVERAGE_CELL_LIMIT = 1_000_000
 # A robot stands still while it stays this close to one pose (m, rad): dithering between tiny turns or
 # creeping back and forth is standing still too, not just a zero velocity.
 STOP_RADIUS, STOP_TURN = 0.05, 0.1

@@ -20,6 +20,8 @@ if TYPE_CHECKING:
     from stage_sim.sim.simulation import Simulation
 
 FREE_RGB = (244, 244, 244)
+#: Most pixels of the map the page gets (one per cell up to this; a larger world's map is downsampled).
+MAP_PIXELS = 16_000_000
 """Free space, as the rendered pictures show it."""
 
 
@@ -101,7 +103,7 @@ def _map_png(sim: Simulation) -> tuple[bytes, int]:
 
     static = sim.static
     colors = {model.name: model.color for model in reversed(list(sim.description.walk()))}
-    labels, step = static.map_labels()
+    labels, step = static.map_labels(MAP_PIXELS)
     hexas = [css_color(colors.get(body.name, (0.0, 0.0, 0.0, 1.0))) for body in static.bodies]
     palette = np.array([FREE_RGB, *([int(h[i:i + 2], 16) for i in (1, 3, 5)] for h in hexas)], dtype=np.uint8)
     image = Image.fromarray(palette[labels[::-1]])
