@@ -117,6 +117,7 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     motion.warm(len(sim.robots))
     poses = sim.start_poses
     collision.overlapping(poses)
+    collision.resolve(poses, np.full_like(poses, 1e-3), 0.1)  # loads the sweep kernels (nothing is kept)
     sensing.sense(poses, 0.0)
     mark_numba_loaded()
     return CompiledParts(collision, sensing, motion)
