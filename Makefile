@@ -63,6 +63,7 @@ bench: setup
 	done
 	$(PY) benchmarks/stageros.py
 	$(PY) benchmarks/startup.py
+	taskset -c 0 $(PY) benchmarks/worlds.py
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts
