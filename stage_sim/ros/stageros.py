@@ -149,6 +149,13 @@ class StageRos(Node):
         ]
         self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
 
+    def destroy_node(self) -> None:
+        """Destroy the subscriptions before the publishers: Fast DDS takes time in proportion to the
+        participant's readers to delete each writer (1000 robots: 18 s of CPU the other way round)."""
+        for subscription in list(self.subscriptions):
+            self.destroy_subscription(subscription)
+        super().destroy_node()
+
     def _step_timer(self, start: bool) -> Timer:
         """The steady wall timer that steps the world every ``interval_sim / speedup`` (0: back to back)."""
         period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0

@@ -17,6 +17,7 @@ from stage_sim.maps.body_geometry import body_polygons, global_poses, transform_
 from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.kinematics import DRIVE_CODES
 from stage_sim.worldfile.description import Model, Pose, PositionSettings, Sensor, WorldDescription, WorldWarning
+from stage_sim.worldfile.errors import SourceLocation
 
 
 @dataclass(frozen=True)
@@ -77,14 +78,19 @@ def build_robots(description: WorldDescription, warnings: list[WorldWarning]) ->
     poses = global_poses(description)
     spacing = description.settings.resolution / 2
     robots = []
+    several: dict[SourceLocation | None, list[str]] = {}  # rangers with several sensors, by where they are defined
     for index, model in enumerate(description.robots()):
         pose = poses[id(model)]
         outline, z_band = _body_outline(model, pose, poses, spacing)
-        rangers = tuple(_rangers(model, pose, poses, warnings))
+        rangers = tuple(_rangers(model, pose, poses, several))
         settings = model.position or PositionSettings()
         robots.append(
             RobotSpec(index, model.name, model, (pose.x, pose.y, pose.yaw), settings, z_band, outline, rangers)
         )
+    # One warning per definition, not per robot: a swarm of a thousand must not bury the log.
+    for location, messages in several.items():
+        more = f" (and {len(messages) - 1} more rangers defined there)" if len(messages) > 1 else ""
+        warnings.append(WorldWarning(messages[0] + more, location))
     return robots
 
 
@@ -111,16 +117,17 @@ def _relative(base: Pose, pose: Pose) -> Pose:
     return Pose(c * dx + s * dy, -s * dx + c * dy, pose.z - base.z, pose.yaw - base.yaw)
 
 
-def _rangers(robot: Model, robot_pose: Pose, poses: dict[int, Pose], warnings: list[WorldWarning]) -> list[RangerSpec]:
+def _rangers(
+    robot: Model, robot_pose: Pose, poses: dict[int, Pose], several: dict[SourceLocation | None, list[str]]
+) -> list[RangerSpec]:
+    """The robot's rangers; those with several sensors are noted in ``several`` (their first is simulated)."""
     rangers = []
     for child in robot.children:
         if child.type != "ranger" or not child.sensors:
             continue
         if len(child.sensors) > 1:
-            warnings.append(WorldWarning(
-                f"ranger '{child.name}' has {len(child.sensors)} sensors; like stageros only the first is simulated",
-                child.location,
-            ))
+            several.setdefault(child.location, []).append(
+                f"ranger '{child.name}' has {len(child.sensors)} sensors; like stageros only the first is simulated")
         sensor = child.sensors[0]
         ranger_pose = _relative(robot_pose, poses[id(child)])
         # Stage: ray origin = ranger pose ⊕ ranger origin ⊕ sensor pose, raised by half the sensor height.

@@ -19,8 +19,8 @@ OWN_WORLDS = Path(__file__).resolve().parent / "worlds"
 
 STAGEROS_TOO_SLOW = {
     "stage-worlds/benchmark/hospital.world": (
-        "stageros needs over 10 s of CPU to bring up 1000 robots (issue #14): the simulation loads in 4 s, "
-        "the ROS entities of 1000 robots take the rest"),
+        "stageros needs 13-15 s of CPU for 1000 robots (issue #14): world and simulation ~4 s, creating the "
+        "5000 DDS endpoints of 1000 robots ~5 s and deleting them ~3 s in rclpy/Fast DDS"),
 }
 """Worlds that load, but where stageros takes over 10 s of CPU to come up (strict xfail: remove them then)."""
 
