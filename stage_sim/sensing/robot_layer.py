@@ -19,11 +19,10 @@ import numpy as np
 
 from stage_sim.maps.tiles import TILE, TileGrid
 from stage_sim.sensing.distance_field import tile_square_fields
+from stage_sim.sensing.stage_walk import BLOCK
 
 #: ``hit_robot`` of a cell covered by two or more robots.
 SEVERAL_ROBOTS = -2
-#: Robot occupancy blocks: 2**BLOCK cells a side.
-BLOCK = 3
 #: Blocks per tile side.
 TILE_BLOCKS = TILE >> BLOCK
 #: :attr:`RobotLayer.regions` of a region holding robot cells none of which this layer sees.

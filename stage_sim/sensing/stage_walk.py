@@ -41,6 +41,8 @@ from stage_sim.maps.tiles import TILE, TILE_BITS, TileGrid, TileLayer
 #: Cells per region side (Stage's ``RBITS = 5``): the world's tiles are its regions.
 REGION_BITS = TILE_BITS
 REGION = TILE
+#: Robot occupancy blocks inside a region, 2**BLOCK cells a side: the walk crosses robot-free blocks at once.
+BLOCK = 3
 #: Stage turns a beam at exactly angle 0 into this angle (a zero sine would divide by zero).
 ZERO_ANGLE = 1e-12
 

@@ -31,8 +31,7 @@ import numba
 import numpy as np
 
 from stage_sim.sensing.distance_field import SQUARE_CAP
-from stage_sim.sensing.robot_layer import BLOCK
-from stage_sim.sensing.stage_walk import REGION, REGION_BITS
+from stage_sim.sensing.stage_walk import BLOCK, REGION, REGION_BITS
 
 #: Free stretches longer than this (steps) are crossed by :func:`walk_prefix`'s arithmetic, shorter ones
 #: step by step.
