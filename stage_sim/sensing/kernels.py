@@ -8,7 +8,9 @@ Two implementations exist and give identical answers (``tests/sensing``, ``tests
 
 Choice, strongest first: the explicit argument (``Simulation(kernels=...)``, ``--kernels``), the
 environment variable ``STAGE_SIM_KERNELS``, the default ``numba``. If numba cannot be imported the
-numpy path runs after a one-line warning. Threads likewise: argument, ``STAGE_SIM_THREADS``, 1.
+numpy path runs after a one-line warning. A :class:`~stage_sim.sim.simulation.Simulation` whose kernels
+nobody chose reaches the default through :mod:`stage_sim.sim.kernel_upgrade` (numpy first, numba once it
+has loaded in the background). Threads likewise: argument, ``STAGE_SIM_THREADS``, 1.
 
 Compiled kernels are cached on disk (``cache=True``) next to the package, or, when that folder is not
 writable (a system-wide install), in ``~/.cache/stage_sim`` (``NUMBA_CACHE_DIR`` when set wins). The
