@@ -13,7 +13,9 @@ import math
 
 import numpy as np
 
+from stage_sim.wander import kernels
 from stage_sim.wander.config import WanderConfig
+from stage_sim.wander.frames import first_per_cell
 from stage_sim.wander.velocity_arcs import arc_poses, candidate_commands
 
 # Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
@@ -45,6 +47,16 @@ class ArcPlanner:
         margin = config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
         self._groups = [(v * CHECK_TIMES[-1] + self.radius + margin, np.flatnonzero(speeds == v))
                         for v in np.unique(speeds)]
+        # The arc poses as the check reads them: positions, and the cosine and sine of each yaw computed
+        # group by group exactly as the vectorised check did (a vectorised cosine may round differently by
+        # position in the array).
+        self._x, self._y = (np.ascontiguousarray(self._poses[:, :, k]) for k in range(2))
+        self._cos, self._sin = np.empty_like(self._x), np.empty_like(self._x)
+        for _, rows in self._groups:
+            yaw = self._poses[rows, :, 2, None]
+            self._cos[rows], self._sin[rows] = np.cos(yaw)[..., 0], np.sin(yaw)[..., 0]
+        self._turn_x, self._turn_y = (np.ascontiguousarray(self._poses[:, TURN_CHECK, k]) for k in range(2))
+        kernels.warm_up()
 
     def choose(
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
@@ -63,7 +75,7 @@ class ArcPlanner:
         # How near each point could come within the horizon: moving ones come nearer.
         distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
         near = distance < self._groups[-1][0]
-        _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
+        thin = first_per_cell(points[near], PLAN_CELL)
         order = thin[np.argsort(distance[near][thin])]
         points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
         moving = moving[near][order]
@@ -74,15 +86,13 @@ class ArcPlanner:
         keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
                     + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
         limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
-        closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
+        counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
-            count = int(np.searchsorted(distance, reach))
-            if count:
-                x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
-                c, s = np.cos(yaw), np.sin(yaw)
-                dx, dy = points[:count, 0] - x, points[:count, 1] - y
-                margin = self.body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:, :count]
-                closest[rows] = margin.min(axis=2)
+            counts[rows] = np.searchsorted(distance, reach)
+        px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
+        # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
+        closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py,
+                                      np.ascontiguousarray(limit), self.boxes)
         hit = np.logical_or.accumulate(closest < 0, axis=1)
         safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
         clearance = np.where(hit, np.inf, closest).min(axis=1)
@@ -108,8 +118,8 @@ class ArcPlanner:
 
     def _cramped(self, points: np.ndarray) -> np.ndarray:
         """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
-        x, y = (self._poses[:, TURN_CHECK, k, None] for k in range(2))
-        nearest = np.hypot(points[:, 0] - x, points[:, 1] - y).min(axis=1, initial=np.inf)
+        px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
+        nearest = kernels.nearest_distance(self._turn_x, self._turn_y, px, py)
         return np.maximum(self.radius + self.config.safety_distance - nearest, 0.0)
 
     def body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -121,3 +131,4 @@ class ArcPlanner:
             box = np.hypot(dx, dy)
             distance = box if distance is None else np.minimum(distance, box)
         return distance
+
