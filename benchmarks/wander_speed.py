@@ -2,8 +2,9 @@
 
 ``.venv/bin/python benchmarks/wander_speed.py [--world W ...] [--steps N] [--seed S] [--profile]`` steps each
 world N times (default rooms.world, 1800 steps = 3 sim-minutes) with the wanderer deciding before every step,
-and prints one JSON line per world: decisions, wander_ms per decision, step_ms per simulation step, wall_s.
-The runs are deterministic for a seed, so two trees that decide identically time the same decisions.
+and prints one JSON line per world: decisions, wander_ms per decision and step_ms per simulation step (CPU
+time of this process, less disturbed by other load than wall time), wall_s. The runs are deterministic for a
+seed, so two trees that decide identically time the same decisions.
 ``--profile`` prints the wanderer's ten costliest functions (cProfile, cumulative) to stderr. Pin with
 ``taskset -c 0`` and run on a quiet machine: figures taken under load are noisy.
 """
@@ -34,15 +35,15 @@ def measure(world: str, steps: int, seed: int, profiler: cProfile.Profile | None
     wander_s = step_s = 0.0
     start = time.perf_counter()
     for _ in range(steps):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         if profiler:
             profiler.enable()
         driver.decide()
         if profiler:
             profiler.disable()
-        t1 = time.perf_counter()
+        t1 = time.process_time()
         sim.step()
-        wander_s, step_s = wander_s + t1 - t0, step_s + time.perf_counter() - t1
+        wander_s, step_s = wander_s + t1 - t0, step_s + time.process_time() - t1
     decisions = steps * len(driver.wanderers)
     return {"world": world, "seed": seed, "steps": steps, "decisions": decisions,
             "wander_ms": round(1000 * wander_s / decisions, 3), "step_ms": round(1000 * step_s / steps, 3),

@@ -92,7 +92,7 @@ class ArcPlanner:
         px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
         # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
         closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py,
-                                      np.ascontiguousarray(limit), self.boxes)
+                                      np.ascontiguousarray(limit), self.boxes, self.radius)
         hit = np.logical_or.accumulate(closest < 0, axis=1)
         safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
         clearance = np.where(hit, np.inf, closest).min(axis=1)

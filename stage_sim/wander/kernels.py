@@ -17,6 +17,8 @@ import math
 import numba
 import numpy as np
 
+ROUNDING = 1e-9  # m: far more than the rounding error of any distance the checks compare
+
 
 @numba.njit(cache=True)
 def _body_distance(x: float, y: float, boxes: np.ndarray) -> float:
@@ -32,12 +34,17 @@ def _body_distance(x: float, y: float, boxes: np.ndarray) -> float:
 @numba.njit(cache=True)
 def arc_margins(
     x: np.ndarray, y: np.ndarray, cos: np.ndarray, sin: np.ndarray, counts: np.ndarray, px: np.ndarray,
-    py: np.ndarray, limit: np.ndarray, boxes: np.ndarray,
+    py: np.ndarray, limit: np.ndarray, boxes: np.ndarray, radius: float,
 ) -> np.ndarray:
     """Per candidate and check time (C, T): the least margin ``body distance - limit[t, p]`` of the body at the
     arc pose (``x``, ``y`` and the cosine and sine of its yaw, each (C, T)) over the first ``counts[c]``
-    points (``px``, ``py``); inf with no points. An arc's first negative margin (a hit) ends its check: the
-    times after it are -inf."""
+    points (``px``, ``py``); inf with no points. The body lies within ``radius`` of its origin.
+
+    Only the sign of a margin after an arc's first hit matters (and not even that once the arc is hit), so
+    an arc's check stops at its first negative margin after the first time (the later times read -inf); at
+    the first time the least margin is exact (it ranks the arcs when none stays clear). A point whose
+    distance from the body's origin, less ``radius``, leaves a margin above the least so far (by more than
+    any rounding) cannot lower it and is skipped."""
     candidates, times = x.shape
     closest = np.full((candidates, times), np.inf)
     for c in range(candidates):
@@ -46,8 +53,11 @@ def arc_margins(
             cx, cy, co, si = x[c, t], y[c, t], cos[c, t], sin[c, t]
             for p in range(counts[c]):
                 dx, dy = px[p] - cx, py[p] - cy
-                margin = _body_distance(co * dx + si * dy, co * dy - si * dx, boxes) - limit[t, p]
-                least = min(least, margin)
+                if math.sqrt(dx * dx + dy * dy) - radius - limit[t, p] > least + ROUNDING:
+                    continue
+                least = min(least, _body_distance(co * dx + si * dy, co * dy - si * dx, boxes) - limit[t, p])
+                if least < 0 and t > 0:
+                    break
             closest[c, t] = least
             if least < 0:
                 closest[c, t + 1:] = -np.inf
@@ -136,7 +146,7 @@ def warm_up() -> None:
     """Compile (or load from the cache) every kernel now, on tiny inputs."""
     table = np.zeros((1, 1))
     arc_margins(table, table, table, table, np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0), table,
-                np.zeros((1, 4)))
+                np.zeros((1, 4)), 1.0)
     nearest_distance(np.zeros(1), np.zeros(1), np.zeros(0), np.zeros(0))
     mark_scan(np.zeros(4, dtype=np.int8), np.zeros(4, dtype=np.uint8), np.zeros(2), np.zeros((1, 2)),
               np.zeros(1, dtype=np.bool_), np.zeros(1), np.zeros(1), np.zeros((0, 2)), 1.0, 1, 2, -1, 3, 6)
