@@ -59,7 +59,8 @@ class WanderDriver:
         sim = self.sim
         for robot, wanderer in self.wanderers.items():
             x, y, yaw = (float(v) for v in sim.odometry_poses[robot])
-            sim.set_velocity(robot, *wanderer.decide(self.reading(robot), sim.sim_time, (x, y, through_quaternion(yaw))))
+            pose = (x, y, through_quaternion(yaw))
+            sim.set_velocity(robot, *wanderer.decide(self.reading(robot), sim.sim_time, pose))
 
 
 def _float32(value: float) -> float:
