@@ -91,7 +91,7 @@ class ArcPlanner:
             counts[rows] = np.searchsorted(distance, reach)
         px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
         # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
-        closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py,
+        closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py, distance,
                                       np.ascontiguousarray(limit), self.boxes, self.radius)
         hit = np.logical_or.accumulate(closest < 0, axis=1)
         safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
@@ -102,7 +102,7 @@ class ArcPlanner:
         score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
                  + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
-                 - (1.0 if door else 8.0) * self._cramped(points)
+                 - (1.0 if door else 8.0) * self._cramped(px, py, distance)
                  - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
                  - 3.0 * (self.commands[:, 2] * turn_sign < 0))
         reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
@@ -116,10 +116,10 @@ class ArcPlanner:
             score = closest[:, 0]
         return int(np.argmax(np.where(admissible, score, -np.inf)))
 
-    def _cramped(self, points: np.ndarray) -> np.ndarray:
-        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
-        px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
-        nearest = kernels.nearest_distance(self._turn_x, self._turn_y, px, py)
+    def _cramped(self, px: np.ndarray, py: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,); the
+        points (``px``, ``py``) no farther than ``near`` from the origin and sorted by it."""
+        nearest = kernels.nearest_distance(self._turn_x, self._turn_y, px, py, near)
         return np.maximum(self.radius + self.config.safety_distance - nearest, 0.0)
 
     def body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -34,24 +34,32 @@ def _body_distance(x: float, y: float, boxes: np.ndarray) -> float:
 @numba.njit(cache=True)
 def arc_margins(
     x: np.ndarray, y: np.ndarray, cos: np.ndarray, sin: np.ndarray, counts: np.ndarray, px: np.ndarray,
-    py: np.ndarray, limit: np.ndarray, boxes: np.ndarray, radius: float,
+    py: np.ndarray, near: np.ndarray, limit: np.ndarray, boxes: np.ndarray, radius: float,
 ) -> np.ndarray:
     """Per candidate and check time (C, T): the least margin ``body distance - limit[t, p]`` of the body at the
     arc pose (``x``, ``y`` and the cosine and sine of its yaw, each (C, T)) over the first ``counts[c]``
-    points (``px``, ``py``); inf with no points. The body lies within ``radius`` of its origin.
+    points (``px``, ``py``, no farther than ``near`` from the origin and sorted by it); inf with no points.
+    The body lies within ``radius`` of its origin.
 
     Only the sign of a margin after an arc's first hit matters (and not even that once the arc is hit), so
     an arc's check stops at its first negative margin after the first time (the later times read -inf); at
     the first time the least margin is exact (it ranks the arcs when none stays clear). A point whose
     distance from the body's origin, less ``radius``, leaves a margin above the least so far (by more than
-    any rounding) cannot lower it and is skipped."""
+    any rounding) cannot lower it and is skipped; once even the nearest a point may be leaves that margin
+    for the largest limit, so does every point after it, and the check moves on."""
     candidates, times = x.shape
     closest = np.full((candidates, times), np.inf)
     for c in range(candidates):
         for t in range(times):
             least = math.inf
             cx, cy, co, si = x[c, t], y[c, t], cos[c, t], sin[c, t]
+            origin = math.hypot(cx, cy)
+            most = -math.inf
             for p in range(counts[c]):
+                most = max(most, limit[t, p])
+            for p in range(counts[c]):
+                if near[p] - origin - radius - most > least + ROUNDING:
+                    break
                 dx, dy = px[p] - cx, py[p] - cy
                 if math.sqrt(dx * dx + dy * dy) - radius - limit[t, p] > least + ROUNDING:
                     continue
@@ -66,11 +74,15 @@ def arc_margins(
 
 
 @numba.njit(cache=True)
-def nearest_distance(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-    """Per pose (``x[c]``, ``y[c]``) the distance to the nearest point (``px``, ``py``); inf with none."""
+def nearest_distance(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """Per pose (``x[c]``, ``y[c]``) the distance to the nearest point (``px``, ``py``, no farther than ``near``
+    from the origin and sorted by it); inf with none."""
     nearest = np.full(x.shape[0], np.inf)
     for c in range(x.shape[0]):
+        origin = math.hypot(x[c], y[c])
         for p in range(px.shape[0]):
+            if near[p] - origin > nearest[c] + ROUNDING:
+                break
             nearest[c] = min(nearest[c], math.hypot(px[p] - x[c], py[p] - y[c]))
     return nearest
 
@@ -145,8 +157,8 @@ def mark_scan(
 def warm_up() -> None:
     """Compile (or load from the cache) every kernel now, on tiny inputs."""
     table = np.zeros((1, 1))
-    arc_margins(table, table, table, table, np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0), table,
-                np.zeros((1, 4)), 1.0)
-    nearest_distance(np.zeros(1), np.zeros(1), np.zeros(0), np.zeros(0))
+    arc_margins(table, table, table, table, np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros(0),
+                table, np.zeros((1, 4)), 1.0)
+    nearest_distance(np.zeros(1), np.zeros(1), np.zeros(0), np.zeros(0), np.zeros(0))
     mark_scan(np.zeros(4, dtype=np.int8), np.zeros(4, dtype=np.uint8), np.zeros(2), np.zeros((1, 2)),
               np.zeros(1, dtype=np.bool_), np.zeros(1), np.zeros(1), np.zeros((0, 2)), 1.0, 1, 2, -1, 3, 6)
