@@ -49,16 +49,17 @@ def arc_margins(
     for the largest limit, so does every point after it, and the check moves on."""
     candidates, times = x.shape
     closest = np.full((candidates, times), np.inf)
+    most = np.empty_like(limit)  # the largest limit among the first p + 1 points
+    for t in range(times):
+        for p in range(limit.shape[1]):
+            most[t, p] = limit[t, p] if p == 0 else max(most[t, p - 1], limit[t, p])
     for c in range(candidates):
         for t in range(times):
             least = math.inf
             cx, cy, co, si = x[c, t], y[c, t], cos[c, t], sin[c, t]
             origin = math.hypot(cx, cy)
-            most = -math.inf
             for p in range(counts[c]):
-                most = max(most, limit[t, p])
-            for p in range(counts[c]):
-                if near[p] - origin - radius - most > least + ROUNDING:
+                if near[p] - origin - radius - most[t, counts[c] - 1] > least + ROUNDING:
                     break
                 dx, dy = px[p] - cx, py[p] - cy
                 if math.sqrt(dx * dx + dy * dy) - radius - limit[t, p] > least + ROUNDING:
