@@ -131,6 +131,8 @@ class Wanderer:
             if self._door is not None and self._door.progress(pose)[0] > DOOR_THROUGH:
                 self._leave_door(time, given_up=False)  # through, yet not out along the axis: carry on from here
             elif time < self._commit[0]:  # turning one way did not get it going either: back off a little
+                if self._door is not None:  # and give up the doorway: it cannot be entered from here
+                    self._leave_door(time, given_up=True)
                 self._retreat(time, pose, give_up=False)
             else:  # dithering between turns: turn one way only for a while
                 self._commit_turn(time)
