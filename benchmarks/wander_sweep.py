@@ -6,9 +6,9 @@ for seeds S..S+N-1, J processes at a time (default: one per core). Each run pick
 (ROS_DOMAIN_ID is removed from their environment), so runs never hear each other. ``--core`` runs the same
 sessions without ROS: the core simulation stepped as the lockstep session steps it, with the core
 WanderDriver (which hands each wanderer exactly what the ``wander`` node receives, so a seed gives the same
-commands and summaries as through the nodes; a third of the CPU). Prints one JSON line per seed and robot,
-then one summary line per world; a seed falls short with a stall event, a stop over 3 s or coverage under
-0.95. Exit status 1 when a run fails or a seed falls short.
+commands and summaries as through the nodes, for less CPU: no DDS, no messages). Prints one JSON line per
+seed and robot, then one summary line per world; a seed falls short with a stall event, a stop over 3 s or
+coverage under 0.95. Exit status 1 when a run fails or a seed falls short.
 """
 
 from __future__ import annotations
