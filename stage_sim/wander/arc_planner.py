@@ -70,6 +70,9 @@ class ArcPlanner:
         the other way are penalised (0: none); ``reverse_room``: metres behind known to be clear (the laser
         does not see backwards); ``retreat_turn``: retreating, the reverse command nearest this turn rate
         wins if any is clear (and no allowance for odometry drift is made: the body has just been there).
+        When no arc keeps the margins long enough (the body already inside them, as where a retreat, which
+        keeps only half of them, ended), the arcs are checked again against half the safety distance and no
+        drift allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
         """
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
@@ -83,30 +86,36 @@ class ArcPlanner:
         retreating = retreat_turn is not None
         if retreating:
             allowance = np.zeros_like(allowance)
-        keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
-                    + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
-        limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+        approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
+        margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance]
+        if not retreating:  # wedged inside those margins (where a retreat, which keeps half, ended): half, no drift
+            margins.append(np.full_like(allowance, 0.5 * config.safety_distance))
         counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
             counts[rows] = np.searchsorted(distance, reach)
         px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
-        # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
-        closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py, distance,
-                                      np.ascontiguousarray(limit), self.boxes, self.radius)
-        hit = np.logical_or.accumulate(closest < 0, axis=1)
-        safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+        speed = self.commands[:, 0]
+        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
+        for margin in margins:
+            keep_off = margin + approach
+            limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+            # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
+            closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py, distance,
+                                          np.ascontiguousarray(limit), self.boxes, self.radius)
+            hit = np.logical_or.accumulate(closest < 0, axis=1)
+            safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+            admissible = (safe_until >= ADMISSIBLE_S) & reversible
+            if admissible.any():
+                break
         clearance = np.where(hit, np.inf, closest).min(axis=1)
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
-        speed = self.commands[:, 0]
         score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
                  + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
                  - (1.0 if door else 8.0) * self._cramped(px, py, distance)
                  - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
                  - 3.0 * (self.commands[:, 2] * turn_sign < 0))
-        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
-        admissible = (safe_until >= ADMISSIBLE_S) & reversible
         if retreating and (admissible & (speed < 0)).any():
             admissible &= speed < 0
             score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
