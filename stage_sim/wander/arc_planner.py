@@ -61,18 +61,20 @@ class ArcPlanner:
     def choose(
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
         previous_turn: float, door: bool, backing: bool, turn_sign: float, reverse_room: float,
-        retreat_turn: float | None = None,
+        retreat_turn: float | None = None, wedged: bool = False,
     ) -> int:
         """Index of the best command for ``heading`` (robot frame) among those whose arc keeps clear.
 
         ``door``: passing a narrow doorway (little clearance, no room to turn: ask for less); ``backing``:
         getting out of a tight spot (half the margin will do, reversing is preferred); ``turn_sign``: turns
-        the other way are penalised (0: none); ``reverse_room``: metres behind known to be clear (the laser
-        does not see backwards); ``retreat_turn``: retreating, the reverse command nearest this turn rate
-        wins if any is clear (and no allowance for odometry drift is made: the body has just been there).
-        When no arc keeps the margins long enough (the body already inside them, as where a retreat, which
-        keeps only half of them, ended), the arcs are checked again against half the safety distance and no
-        drift allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
+        (and sideways moves) the other way are penalised (0: none); ``reverse_room``: metres behind known to
+        be clear (the laser does not see backwards); ``retreat_turn``: retreating, the reverse command nearest
+        this turn rate wins if any is clear (and no allowance for odometry drift is made: the body has just been
+        there).
+        ``wedged``: the robot can neither back out nor get going by turning one way; then, when no arc keeps
+        the margins beyond the first check time (the body already inside them, as where a retreat, which keeps
+        only half of them, ended), the arcs are checked again against half the safety distance and no drift
+        allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
         """
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
@@ -88,7 +90,7 @@ class ArcPlanner:
             allowance = np.zeros_like(allowance)
         approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
         margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance]
-        if not retreating:  # wedged inside those margins (where a retreat, which keeps half, ended): half, no drift
+        if wedged and not retreating:  # inside those margins (where a retreat, which keeps half, ended): half, no drift
             margins.append(np.full_like(allowance, 0.5 * config.safety_distance))
         counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
@@ -105,8 +107,8 @@ class ArcPlanner:
             hit = np.logical_or.accumulate(closest < 0, axis=1)
             safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
             admissible = (safe_until >= ADMISSIBLE_S) & reversible
-            if admissible.any():
-                break
+            if admissible.any() or np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
+                break  # something stays clear (if not long enough: of what may be done, the longest)
         clearance = np.where(hit, np.inf, closest).min(axis=1)
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
@@ -115,7 +117,7 @@ class ArcPlanner:
                  - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
                  - (1.0 if door else 8.0) * self._cramped(px, py, distance)
                  - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
-                 - 3.0 * (self.commands[:, 2] * turn_sign < 0))
+                 - 3.0 * ((self.commands[:, 2] * turn_sign < 0) | (self.commands[:, 1] * turn_sign < 0)))
         if retreating and (admissible & (speed < 0)).any():
             admissible &= speed < 0
             score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
