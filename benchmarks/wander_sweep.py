@@ -1,11 +1,14 @@
 """The wanderer on many seeds at once: stall events, longest stop and coverage per seed, then a summary.
 
-``.venv/bin/python benchmarks/wander_sweep.py --seeds N --minutes M [--world W] [--jobs J] [--first-seed S]``
-runs ``launch_scripts/reactive.py W --duration 60*M --speedup 0 --seed s -g`` (lockstep, no view) for
-seeds S..S+N-1, J processes at a time (default: one per core). Each run picks its own private ROS domain
-(ROS_DOMAIN_ID is removed from their environment), so runs never hear each other. Prints one JSON line
-per seed and robot, then one summary line per world; a seed falls short with a stall event, a stop over
-3 s or coverage under 0.95. Exit status 1 when a run fails or a seed falls short.
+``.venv/bin/python benchmarks/wander_sweep.py --seeds N --minutes M [--world W] [--jobs J] [--first-seed S]
+[--core]`` runs ``launch_scripts/reactive.py W --duration 60*M --speedup 0 --seed s -g`` (lockstep, no view)
+for seeds S..S+N-1, J processes at a time (default: one per core). Each run picks its own private ROS domain
+(ROS_DOMAIN_ID is removed from their environment), so runs never hear each other. ``--core`` runs the same
+sessions without ROS: the core simulation stepped as the lockstep session steps it, with the core
+WanderDriver (which hands each wanderer exactly what the ``wander`` node receives, so a seed gives the same
+commands and summaries as through the nodes, for less CPU: no DDS, no messages). Prints one JSON line per
+seed and robot, then one summary line per world; a seed falls short with a stall event, a stop over 3 s or
+coverage under 0.95. Exit status 1 when a run fails or a seed falls short.
 """
 
 from __future__ import annotations
@@ -16,10 +19,11 @@ import os
 import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import Executor, ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
 REACTIVE = REPO / "launch_scripts" / "reactive.py"
 MAX_STALL_EVENTS, MAX_STOP_S, MIN_COVERAGE = 0, 3.0, 0.95
 
@@ -41,15 +45,45 @@ def run_seed(world: str, seed: int, minutes: float) -> dict:
     return result
 
 
+def run_core_seed(world: str, seed: int, minutes: float) -> dict:
+    """The same session without ROS, in this process: each step of the world, then each wanderer's answer
+    to its new scan (the lockstep session's order; the sim's watchdog as stageros sets it)."""
+    from stage_sim.runs.driver import WanderDriver
+    from stage_sim.runs.stats import RunStats
+    from stage_sim.sim.simulation import Simulation
+    from stage_sim.worldfile.bundled import find_world
+    from stage_sim.worldfile.errors import WorldError
+    from stage_sim.worldfile.loader import load_world
+
+    start = time.monotonic()
+    try:
+        description = load_world(find_world(world))
+    except (WorldError, FileNotFoundError, ValueError) as error:
+        return {"seed": seed, "wall_s": 0.0, "returncode": 2, "error": [str(error)]}
+    sim = Simulation(description, seed=seed, watchdog_timeout=0.2)
+    driver, stats = WanderDriver(sim, seed), RunStats(sim)
+    end = minutes * 60
+    if description.settings.quit_time > 0:
+        end = min(end, description.settings.quit_time)
+    while sim.sim_time < end - 1e-9:
+        sim.step()
+        stats.update()
+        driver.decide()
+    names = [robot.name or f"robot_{robot.index}" for robot in sim.robots]
+    return {"seed": seed, "wall_s": round(time.monotonic() - start, 1), "returncode": 0,
+            "robots": stats.summaries(names)}
+
+
 def falls_short(robot: dict) -> bool:
     return (robot["stall_events"] > MAX_STALL_EVENTS or robot["longest_stop_s"] > MAX_STOP_S
             or robot["coverage"] < MIN_COVERAGE)
 
 
-def summary(world: str, minutes: float, results: list[dict]) -> dict:
+def summary(world: str, minutes: float, results: list[dict], path: str) -> dict:
     robots = [r for result in results for r in result.get("robots", [])]
     return {
         "summary": world,
+        "path": path,
         "seeds": len(results),
         "sim_minutes": minutes,
         "failed_runs": sorted(r["seed"] for r in results if r["returncode"] != 0),
@@ -69,17 +103,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--minutes", type=float, required=True, help="sim minutes per run")
     parser.add_argument("--world", default="rooms.world", help="a .world file or a bundled world's name")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at a time")
+    parser.add_argument("--core", action="store_true", help="run the sessions without ROS (same results)")
     args = parser.parse_args(argv)
     seeds = range(args.first_seed, args.first_seed + args.seeds)
+    path = "core" if args.core else "ros"
     results = []
-    with ThreadPoolExecutor(max_workers=args.jobs) as pool:  # threads that each wait on one process
-        for future in as_completed([pool.submit(run_seed, args.world, s, args.minutes) for s in seeds]):
+    # ROS: threads that each wait on one session process; core: the sessions in worker processes.
+    pool: Executor = ProcessPoolExecutor(args.jobs) if args.core else ThreadPoolExecutor(args.jobs)
+    with pool:
+        run = run_core_seed if args.core else run_seed
+        for future in as_completed([pool.submit(run, args.world, s, args.minutes) for s in seeds]):
             result = future.result()
             results.append(result)
             for robot in result.get("robots", [{"error": result.get("error")}]):
-                print(json.dumps({"world": args.world, "seed": result["seed"], "wall_s": result["wall_s"], **robot}),
-                      flush=True)
-    line = summary(args.world, args.minutes, results)
+                print(json.dumps({"world": args.world, "path": path, "seed": result["seed"],
+                                  "wall_s": result["wall_s"], **robot}), flush=True)
+    line = summary(args.world, args.minutes, results, path)
     print(json.dumps(line), flush=True)
     return 1 if line["failed_runs"] or line["seeds_short"] else 0
 

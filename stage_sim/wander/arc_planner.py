@@ -13,7 +13,9 @@ import math
 
 import numpy as np
 
+from stage_sim.wander import kernels
 from stage_sim.wander.config import WanderConfig
+from stage_sim.wander.frames import first_per_cell
 from stage_sim.wander.velocity_arcs import arc_poses, candidate_commands
 
 # Candidate arcs are checked at these times (s): densely while the command is in force, sparser beyond.
@@ -45,25 +47,40 @@ class ArcPlanner:
         margin = config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
         self._groups = [(v * CHECK_TIMES[-1] + self.radius + margin, np.flatnonzero(speeds == v))
                         for v in np.unique(speeds)]
+        # The arc poses as the check reads them: positions, and the cosine and sine of each yaw computed
+        # group by group exactly as the vectorised check did (a vectorised cosine may round differently by
+        # position in the array).
+        self._x, self._y = (np.ascontiguousarray(self._poses[:, :, k]) for k in range(2))
+        self._cos, self._sin = np.empty_like(self._x), np.empty_like(self._x)
+        for _, rows in self._groups:
+            yaw = self._poses[rows, :, 2, None]
+            self._cos[rows], self._sin[rows] = np.cos(yaw)[..., 0], np.sin(yaw)[..., 0]
+        self._turn_x, self._turn_y = (np.ascontiguousarray(self._poses[:, TURN_CHECK, k]) for k in range(2))
+        kernels.warm_up()
 
     def choose(
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
         previous_turn: float, door: bool, backing: bool, turn_sign: float, reverse_room: float,
-        retreat_turn: float | None = None,
+        retreat_turn: float | None = None, wedged: bool = False,
     ) -> int:
         """Index of the best command for ``heading`` (robot frame) among those whose arc keeps clear.
 
         ``door``: passing a narrow doorway (little clearance, no room to turn: ask for less); ``backing``:
         getting out of a tight spot (half the margin will do, reversing is preferred); ``turn_sign``: turns
-        the other way are penalised (0: none); ``reverse_room``: metres behind known to be clear (the laser
-        does not see backwards); ``retreat_turn``: retreating, the reverse command nearest this turn rate
-        wins if any is clear (and no allowance for odometry drift is made: the body has just been there).
+        (and sideways moves) the other way are penalised (0: none); ``reverse_room``: metres behind known to
+        be clear (the laser does not see backwards); ``retreat_turn``: retreating, the reverse command nearest
+        this turn rate wins if any is clear (and no allowance for odometry drift is made: the body has just been
+        there).
+        ``wedged``: the robot can neither back out nor get going by turning one way; then, when no arc keeps
+        the margins beyond the first check time (the body already inside them, as where a retreat, which keeps
+        only half of them, ended), the arcs are checked again against half the safety distance and no drift
+        allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
         """
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
         distance = np.hypot(points[:, 0], points[:, 1]) - moving * config.moving_speed * CHECK_TIMES[-1]
         near = distance < self._groups[-1][0]
-        _, thin = np.unique(np.floor(points[near] / PLAN_CELL).astype(np.int64), axis=0, return_index=True)
+        thin = first_per_cell(points[near], PLAN_CELL)
         order = thin[np.argsort(distance[near][thin])]
         points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
         moving = moving[near][order]
@@ -71,32 +88,36 @@ class ArcPlanner:
         retreating = retreat_turn is not None
         if retreating:
             allowance = np.zeros_like(allowance)
-        keep_off = (config.safety_distance * (0.5 if backing else 1.0) + allowance
-                    + np.outer(CHECK_TIMES, moving * config.moving_speed))  # (T, P)
-        limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
-        closest = np.full(self._poses.shape[:2], np.inf)  # (C, T): least margin to any point; < 0 is a hit
+        approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
+        margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance]
+        if wedged and not retreating:  # inside those margins (where a retreat, which keeps half, ended): half, no drift
+            margins.append(np.full_like(allowance, 0.5 * config.safety_distance))
+        counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
-            count = int(np.searchsorted(distance, reach))
-            if count:
-                x, y, yaw = (self._poses[rows, :, k, None] for k in range(3))
-                c, s = np.cos(yaw), np.sin(yaw)
-                dx, dy = points[:count, 0] - x, points[:count, 1] - y
-                margin = self.body_distance(c * dx + s * dy, c * dy - s * dx) - limit[:, :count]
-                closest[rows] = margin.min(axis=2)
-        hit = np.logical_or.accumulate(closest < 0, axis=1)
-        safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+            counts[rows] = np.searchsorted(distance, reach)
+        px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
+        speed = self.commands[:, 0]
+        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
+        for margin in margins:
+            keep_off = margin + approach
+            limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+            # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
+            closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py, distance,
+                                          np.ascontiguousarray(limit), self.boxes, self.radius)
+            hit = np.logical_or.accumulate(closest < 0, axis=1)
+            safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
+            admissible = (safe_until >= ADMISSIBLE_S) & reversible
+            if admissible.any() or np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
+                break  # something stays clear (if not long enough: of what may be done, the longest)
         clearance = np.where(hit, np.inf, closest).min(axis=1)
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)
-        speed = self.commands[:, 0]
         score = (np.cos(heading - look_yaw) + progress + safe_until / CHECK_TIMES[-1]
                  + (0.5 if door else CLEARANCE_WEIGHT) * np.minimum(clearance, CLEARANCE_CAP) / CLEARANCE_CAP
                  - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
-                 - (1.0 if door else 8.0) * self._cramped(points)
+                 - (1.0 if door else 8.0) * self._cramped(px, py, distance)
                  - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
-                 - 3.0 * (self.commands[:, 2] * turn_sign < 0))
-        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
-        admissible = (safe_until >= ADMISSIBLE_S) & reversible
+                 - 3.0 * ((self.commands[:, 2] * turn_sign < 0) | (self.commands[:, 1] * turn_sign < 0)))
         if retreating and (admissible & (speed < 0)).any():
             admissible &= speed < 0
             score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
@@ -106,10 +127,10 @@ class ArcPlanner:
             score = closest[:, 0]
         return int(np.argmax(np.where(admissible, score, -np.inf)))
 
-    def _cramped(self, points: np.ndarray) -> np.ndarray:
-        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,)."""
-        x, y = (self._poses[:, TURN_CHECK, k, None] for k in range(2))
-        nearest = np.hypot(points[:, 0] - x, points[:, 1] - y).min(axis=1, initial=np.inf)
+    def _cramped(self, px: np.ndarray, py: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,); the
+        points (``px``, ``py``) no farther than ``near`` from the origin and sorted by it."""
+        nearest = kernels.nearest_distance(self._turn_x, self._turn_y, px, py, near)
         return np.maximum(self.radius + self.config.safety_distance - nearest, 0.0)
 
     def body_distance(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -121,3 +142,4 @@ class ArcPlanner:
             box = np.hypot(dx, dy)
             distance = box if distance is None else np.minimum(distance, box)
         return distance
+

@@ -1,4 +1,5 @@
-"""Planar frames for the wanderer: points seen from one robot pose expressed from another."""
+"""Planar geometry for the wanderer: points seen from one robot pose expressed from another, and point sets
+thinned to one point per grid cell."""
 
 from __future__ import annotations
 
@@ -14,3 +15,14 @@ def compose(pose: tuple[float, float, float], points: np.ndarray, inverse: bool 
         dx, dy = points[:, 0] - pose[0], points[:, 1] - pose[1]
         return np.stack([c * dx + s * dy, -s * dx + c * dy], axis=-1)
     return np.stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]], -1)
+
+
+def first_per_cell(points: np.ndarray, cell: float) -> np.ndarray:
+    """Indices of the first point in each occupied grid cell of size ``cell``, ordered by cell (row-major):
+    what ``np.unique(cells, axis=0, return_index=True)`` gives, through a one-dimensional key (faster)."""
+    cells = np.floor(points / cell).astype(np.int64)
+    if not len(cells):
+        return np.zeros(0, dtype=np.int64)
+    low = cells.min(axis=0)
+    span = cells[:, 1].max() - low[1] + 1
+    return np.unique((cells[:, 0] - low[0]) * span + (cells[:, 1] - low[1]), return_index=True)[1]

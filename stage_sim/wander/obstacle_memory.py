@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from stage_sim.wander.arc_planner import MAX_ALLOWANCE
-from stage_sim.wander.frames import compose
+from stage_sim.wander.frames import compose, first_per_cell
 from stage_sim.wander.laser_reading import LaserReading
 
 MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
@@ -49,7 +49,7 @@ class ObstacleMemory:
         points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
         near = distance < self.radius
         world = compose(pose, points[near])
-        _, unique = np.unique(np.floor(world / MEMORY_CELL).astype(np.int64), axis=0, return_index=True)
+        unique = first_per_cell(world, MEMORY_CELL)
         unique.sort()  # the first of a cell is the freshest
         self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
         return points, allowance, moving

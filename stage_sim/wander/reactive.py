@@ -107,6 +107,7 @@ class Wanderer:
         self._retreat_until = -math.inf  # backing out along the trail until then (or until free to turn)
         self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
         self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
+        self._wedged_until = -math.inf  # no way back at all: until then the planner may keep half its margins
 
     def decide(
         self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
@@ -131,6 +132,8 @@ class Wanderer:
             if self._door is not None and self._door.progress(pose)[0] > DOOR_THROUGH:
                 self._leave_door(time, given_up=False)  # through, yet not out along the axis: carry on from here
             elif time < self._commit[0]:  # turning one way did not get it going either: back off a little
+                if self._door is not None and self._door.progress(pose)[0] < 0:  # wedged before the doorway:
+                    self._leave_door(time, given_up=True)  # it cannot be entered from here, give it up
                 self._retreat(time, pose, give_up=False)
             else:  # dithering between turns: turn one way only for a while
                 self._commit_turn(time)
@@ -205,6 +208,7 @@ class Wanderer:
         self.history.forget_recent()  # standing still is judged afresh from here
         if self.history.backed(pose) < TRAIL_STEP:
             self._commit_turn(time)
+            self._wedged_until = self._commit[0]
         if self._retreat_gave_up:
             self._escape(time, self._pick_heading(points, pose))
         return None
@@ -365,7 +369,7 @@ class Wanderer:
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
             backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,
-            retreat_turn=retreat_turn)
+            retreat_turn=retreat_turn, wedged=time < self._wedged_until)
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S

@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from stage_sim.wander import kernels
 from stage_sim.wander.laser_reading import wrap
 
 HIT, PASS, CLIP = 3, -1, 6  # score a cell gains when a beam ends in it, loses when one crosses it; bound
@@ -32,6 +33,7 @@ class SeenSpace:
         self._half = round(extent / cell / 2)
         side = 2 * self._half
         self.score = np.zeros((side, side), dtype=np.int8)
+        self._flags = np.zeros(side * side, dtype=np.uint8)  # scratch of the cell marking: all zero between scans
         self._low = np.array([side, side])  # bounding box of the cells seen so far (index, inclusive low)
         self._high = np.array([0, 0])  # exclusive high
 
@@ -49,25 +51,16 @@ class SeenSpace:
         robot stands (which its laser does not see), count as free too."""
         lengths = np.hypot(*(ends - origin).T)
         steps = np.arange(SAMPLE_STEP, lengths.max(initial=0.0), SAMPLE_STEP)
-        # A beam marks free the cells it crosses up to a cell short of where it ended (its end cell may be a wall).
-        along = steps[None, :] <= (lengths - np.where(hit, self.cell, 0.0))[:, None]
-        fraction = steps[None, :] / np.maximum(lengths, 1e-9)[:, None]
-        crossed = origin + fraction[..., None] * (ends - origin)[:, None, :]
-        body = np.zeros((0, 2)) if body is None else body
-        self._add(self.index(np.concatenate([crossed[along], ends[~hit], body])), PASS)
-        self._add(self.index(ends[hit]), HIT)
-
-    def _add(self, index: np.ndarray, amount: int) -> None:
-        """Add ``amount`` once to each distinct cell among ``index`` (P, 2) that lies in the grid."""
-        side = self.score.shape[0]
-        index = index[np.all((index >= 0) & (index < side), axis=1)]
-        if not len(index):
-            return
-        flat = index[:, 0] * side + index[:, 1]
-        cells = self.score.reshape(-1)  # a cell listed twice is written twice with the same sum: added once
-        cells[flat] = np.clip(cells[flat].astype(np.int16) + amount, -CLIP, CLIP)
-        self._low = np.minimum(self._low, index.min(axis=0))
-        self._high = np.maximum(self._high, index.max(axis=0) + 1)
+        # A beam marks free the cells it crosses up to a cell short of where it ended (its end cell may be a
+        # wall); a cell crossed by several beams counts once.
+        body = np.zeros((0, 2)) if body is None else np.ascontiguousarray(body, dtype=np.float64)
+        bounds = kernels.mark_scan(
+            self.score.reshape(-1), self._flags, np.ascontiguousarray(origin, dtype=np.float64),
+            np.ascontiguousarray(ends, dtype=np.float64), np.ascontiguousarray(hit, dtype=np.bool_), lengths, steps,
+            body, self.cell, self._half, self.score.shape[0], PASS, HIT, CLIP)
+        if bounds[0] <= bounds[2]:
+            self._low = np.minimum(self._low, bounds[:2])
+            self._high = np.maximum(self._high, bounds[2:] + 1)
 
     def route(self, start: tuple[float, float], wanted: Callable[[np.ndarray], np.ndarray]) -> np.ndarray | None:
         """The shortest route (K, 2 odometry-frame cell centres, from ``start`` on) through free cells to the

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from stage_sim.wander.doorways import DoorPassage, find_doorways
+from stage_sim.wander.reactive import DOOR_BEYOND, Wanderer
 from tests.wander.test_reactive import closed_loop, scan_of_segments
 
 WIDTHS = (0.40, 0.69)  # what the wanderer asks for with the course robot: narrower than explore and tour see
@@ -77,3 +78,19 @@ def test_the_wanderer_goes_through_a_narrow_door_into_a_new_room(tmp_path: Path)
     (summary,) = run.stats.summaries(["r"])
     assert summary["stall_events"] == 0 and summary["longest_stop_s"] < 2.0
     assert summary["coverage"] > 0.8  # the room is most of the free space: it has been inside
+
+
+def test_a_doorway_it_is_wedged_in_front_of_is_given_up_while_it_backs_off() -> None:
+    """Odometry that never changes: it stands still however it is commanded. After half a second it turns
+    one way only; still stuck half a second later, it backs off and gives the doorway up (its far side
+    counts as visited), rather than creeping at it for the passage's 30 s."""
+    wanderer = Wanderer(seed=1)
+    scan = scan_of_segments([*wall_with_gap(0.3, (0.2, 0.65), 4.0, vertical=True)])  # the jamb 4 cm ahead
+    door = DoorPassage(np.array([0.3, 0.425]), np.array([1.0, 0.0]), until=30.0)
+    wanderer.mode, wanderer._door = "door", door
+    modes = []
+    for step in range(1, 16):
+        wanderer.decide(scan, step / 10, (0.0, 0.0, 0.0))
+        modes.append(wanderer.mode)
+    assert modes[:5] == ["door"] * 5 and modes[-1] != "door"
+    assert wanderer.visits.visited_since(door.beyond(DOOR_BEYOND), 0.0).all()
