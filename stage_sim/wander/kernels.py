@@ -5,7 +5,8 @@ Each does, element by element, the same float operations in the same order as th
 replaced (numba without fastmath neither fuses multiply-adds nor reassociates; ``math.hypot`` is the C
 library's, as ``np.hypot``'s is), so the wanderer decides exactly as before (``tests/wander/
 test_decisions.py`` replays recorded runs); they only spare the large temporary arrays, and the arc check
-stops at an arc's first collision, after which nothing about the arc matters. Compiled on first use and
+stops at an arc's first collision, after which nothing about the arc matters. Without numba the same
+functions run as plain Python (``tests/wander/test_kernel_fallback.py``). Compiled on first use and
 cached on disk (``cache=True``: next to this file, or numba's user cache when that is not writable);
 :func:`warm_up` loads them before a robot's first scan, so that no decision waits for the compiler.
 """
@@ -13,14 +14,26 @@ cached on disk (``cache=True``: next to this file, or numba's user cache when th
 from __future__ import annotations
 
 import math
+import warnings
 
-import numba
 import numpy as np
+
+try:
+    import numba
+except Exception as error:  # missing or broken: the same loops run as plain Python (same decisions, slower)
+    numba = None
+    warnings.warn(f"numba unavailable ({error}); the wanderer's checks run as plain Python, slowly",
+                  RuntimeWarning, stacklevel=2)
+
+def _compiled(function):
+    """``numba.njit(cache=True)`` of ``function``, or the function itself when numba is unavailable."""
+    return function if numba is None else numba.njit(cache=True)(function)
+
 
 ROUNDING = 1e-9  # m: far more than the rounding error of any distance the checks compare
 
 
-@numba.njit(cache=True)
+@_compiled
 def _body_distance(x: float, y: float, boxes: np.ndarray) -> float:
     """Distance from a body-frame point to the nearest of the body's rectangles (0 inside)."""
     best = math.inf
@@ -31,7 +44,7 @@ def _body_distance(x: float, y: float, boxes: np.ndarray) -> float:
     return best
 
 
-@numba.njit(cache=True)
+@_compiled
 def arc_margins(
     x: np.ndarray, y: np.ndarray, cos: np.ndarray, sin: np.ndarray, counts: np.ndarray, px: np.ndarray,
     py: np.ndarray, near: np.ndarray, limit: np.ndarray, boxes: np.ndarray, radius: float,
@@ -74,7 +87,7 @@ def arc_margins(
     return closest
 
 
-@numba.njit(cache=True)
+@_compiled
 def nearest_distance(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: np.ndarray, near: np.ndarray) -> np.ndarray:
     """Per pose (``x[c]``, ``y[c]``) the distance to the nearest point (``px``, ``py``, no farther than ``near``
     from the origin and sorted by it); inf with none."""
@@ -88,7 +101,7 @@ def nearest_distance(x: np.ndarray, y: np.ndarray, px: np.ndarray, py: np.ndarra
     return nearest
 
 
-@numba.njit(cache=True)
+@_compiled
 def _collect(x: float, y: float, cell: float, half: int, side: int, flags: np.ndarray, found: np.ndarray,
              n: int, bounds: np.ndarray) -> int:
     """Append the flat index of the grid cell holding (x, y) to ``found[:n]`` unless it is off the grid or
@@ -107,7 +120,7 @@ def _collect(x: float, y: float, cell: float, half: int, side: int, flags: np.nd
     return n + 1
 
 
-@numba.njit(cache=True)
+@_compiled
 def _add_once(cells: np.ndarray, flags: np.ndarray, found: np.ndarray, n: int, amount: int, clip: int) -> None:
     """Add ``amount`` (clipped to ±``clip``) once to each cell of ``found[:n]``, and clear their flags."""
     for k in range(n):
@@ -116,7 +129,7 @@ def _add_once(cells: np.ndarray, flags: np.ndarray, found: np.ndarray, n: int, a
         flags[flat] = 0
 
 
-@numba.njit(cache=True)
+@_compiled
 def mark_scan(
     cells: np.ndarray, flags: np.ndarray, origin: np.ndarray, ends: np.ndarray, hit: np.ndarray,
     lengths: np.ndarray, steps: np.ndarray, extra: np.ndarray, cell: float, half: int, side: int,
