@@ -22,7 +22,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.timer import Timer
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import LaserScan
@@ -53,6 +53,9 @@ NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
 NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# Every request is a caller waiting for its answer: the default services queue (the last 10) drops requests
+# whenever the executor lags (numba loading on its thread, a command flood), and those callers hang forever.
+EVERY_REQUEST = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 
 
 @dataclass
@@ -135,7 +138,7 @@ class StageRos(Node):
                 self.create_subscription(
                     Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10,
                     event_callbacks=NO_SUB_EVENTS)
-        self.create_service(Empty, "reset_positions", self.on_reset)
+        self.create_service(Empty, "reset_positions", self.on_reset, qos_profile=EVERY_REQUEST)
         # Messages are built once and refilled every step: publishing serialises them, so reuse is safe.
         self._out = [
             _RobotMessages(

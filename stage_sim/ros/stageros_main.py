@@ -16,12 +16,14 @@ import sys
 os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 import rclpy
+import rclpy.logging
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from stage_sim.bags.errors import BagError
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
+from stage_sim.ros.core_log import core_log_on
 from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.view import add_view_options, viewing
@@ -60,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
-        with stop_requests() as stop:
+        with stop_requests() as stop, core_log_on(rclpy.logging.get_logger("stageros")):
             node = StageRos(
                 args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None,
                 kernels=args.kernels, threads=args.threads)
