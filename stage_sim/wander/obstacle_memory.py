@@ -4,12 +4,15 @@ The laser does not see behind the robot, yet turning in place swings the rear co
 sector; so the nearby points that have left the field of view are kept, in the odometry frame, each with a
 safety allowance that grows with the odometry error accumulated since it was seen (metres driven, radians
 turned), and forgotten once that allowance is too large to plan with. Points where the previous scan saw
-free space are flagged as moving: something came in, such as another robot.
+free space are flagged as moving: something came in, such as another robot. Near points are also held
+against the scan of SLOW_SCANS scans ago: a robot reversing blind at 0.15 m/s moves too little from one scan
+to the next to be told from sensor quantisation, yet would run into a robot that took it for a wall.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
 
@@ -20,6 +23,8 @@ from stage_sim.wander.laser_reading import LaserReading
 MEMORY_CELL = 0.03  # m: remembered points are thinned to one per cell of this size
 ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net turn (m/m, rad/rad) since a point was seen
 MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free space for a point to be moving
+SLOW_SCANS = 5  # scans back (0.5 s at 10 Hz) of the scan that near points are also held against
+SLOW_RANGE = 1.5  # m: points this near are checked for slow movers (farther ones cannot reach the body in time)
 
 
 class ObstacleMemory:
@@ -28,7 +33,8 @@ class ObstacleMemory:
     def __init__(self, radius: float) -> None:
         self.radius = radius
         self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
-        self._last_scan: tuple | None = None  # the previous scan: laser pose (odometry frame) and ranges
+        # The latest scans, oldest first: laser pose (odometry frame) and ranges (misses at range_max).
+        self._scans: deque[tuple] = deque(maxlen=SLOW_SCANS)
 
     def update(
         self, reading: LaserReading, pose: tuple[float, float, float], odometry: np.ndarray
@@ -56,25 +62,34 @@ class ObstacleMemory:
 
     def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
         """Per beam: whether it hits something where the previous scan saw free space (its beam, or a
-        neighbour, reached further), i.e. something that moved in, such as another robot."""
+        neighbour, reached further), or, within SLOW_RANGE, where the scan SLOW_SCANS back did: something
+        that moved in, such as another robot."""
         ranges = np.asarray(reading.ranges, dtype=np.float64)
         x, y, yaw = reading.laser_pose
         here = (pose[0] + math.cos(pose[2]) * x - math.sin(pose[2]) * y,
                 pose[1] + math.sin(pose[2]) * x + math.cos(pose[2]) * y, pose[2] + yaw)
-        previous, self._last_scan = self._last_scan, (here, np.where(reading.hits(), ranges, reading.range_max))
-        if previous is None:
-            return np.zeros(len(ranges), dtype=bool)
-        (px, py, pyaw), before = previous
-        angles = here[2] + reading.angle_min + np.arange(len(ranges)) * reading.angle_increment
-        end = np.stack([here[0] + ranges * np.cos(angles), here[1] + ranges * np.sin(angles)], axis=-1)
-        seen_from = compose((px, py, pyaw), end, inverse=True)  # the hit points in the previous laser frame
-        distance = np.hypot(seen_from[:, 0], seen_from[:, 1])
-        index = np.rint((np.arctan2(seen_from[:, 1], seen_from[:, 0]) - reading.angle_min)
-                        / reading.angle_increment).astype(np.int64)
-        padded = np.concatenate([[np.inf], before, [np.inf]])
-        inside = (index >= 0) & (index < len(before))
-        index = np.clip(index, 0, len(before) - 1) + 1
-        free_to = np.minimum(np.minimum(padded[index - 1], padded[index]), padded[index + 1])
-        nearer = inside & reading.hits() & (distance < free_to - (MOVED + MOVED_PER_M * distance))
+        hits = reading.hits()
+        nearer = np.zeros(len(ranges), dtype=bool)
+        if self._scans:
+            angles = here[2] + reading.angle_min + np.arange(len(ranges)) * reading.angle_increment
+            end = np.stack([here[0] + ranges * np.cos(angles), here[1] + ranges * np.sin(angles)], axis=-1)
+            nearer = hits & _inside_free_space(end, reading, *self._scans[-1])
+            if len(self._scans) == SLOW_SCANS:
+                nearer |= hits & (ranges < SLOW_RANGE) & _inside_free_space(end, reading, *self._scans[0])
+        self._scans.append((here, np.where(hits, ranges, reading.range_max)))
         nearer = np.concatenate([[False], nearer, [False]])
         return nearer[1:-1] & (nearer[:-2] | nearer[2:])  # a lone beam is an edge effect, not a body
+
+
+def _inside_free_space(end: np.ndarray, reading: LaserReading, laser: tuple, before: np.ndarray) -> np.ndarray:
+    """Per hit point (odometry frame): whether a scan taken from ``laser`` with ``before`` ranges saw free space
+    there (its beam, or a neighbour, reached further by the quantisation margin)."""
+    seen_from = compose(laser, end, inverse=True)  # the hit points in that scan's laser frame
+    distance = np.hypot(seen_from[:, 0], seen_from[:, 1])
+    index = np.rint((np.arctan2(seen_from[:, 1], seen_from[:, 0]) - reading.angle_min)
+                    / reading.angle_increment).astype(np.int64)
+    padded = np.concatenate([[np.inf], before, [np.inf]])
+    inside = (index >= 0) & (index < len(before))
+    index = np.clip(index, 0, len(before) - 1) + 1
+    free_to = np.minimum(np.minimum(padded[index - 1], padded[index]), padded[index + 1])
+    return inside & (distance < free_to - (MOVED + MOVED_PER_M * distance))
