@@ -14,6 +14,8 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from stage_sim.bags.errors import BagError
+
 if TYPE_CHECKING:
     from stage_sim.bags.recorder import BagRecorder
     from stage_sim.ros.stageros import StageRos
@@ -35,7 +37,11 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
     if not args.bag:
         yield None
         return
-    from stage_sim.bags.recorder import BagRecorder
+    try:
+        from stage_sim.bags.recorder import BagRecorder
+    except ImportError as error:  # a ROS install whose rosdep did not bring the bag libraries
+        raise BagError(f"--bag needs the Python package '{error.name or error}' (pip install mcap mcap-ros2-support "
+                       "rosbags)") from error
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
                            topics=args.bag_topics, with_map=stage.map_pub is not None, prog=prog)

@@ -71,7 +71,13 @@ def viewing(stage: StageRos, args: argparse.Namespace) -> Iterator[LiveView | No
     if args.no_view:
         yield None
         return
-    from stage_sim.view.live import LiveView
+    try:
+        from stage_sim.view.live import LiveView
+    except ImportError as error:  # a ROS install whose rosdep did not bring aiohttp: run on without the view
+        print(f"view: not served: the Python package '{error.name or error}' is missing (pip install aiohttp); "
+              "-g turns the view off", file=sys.stderr, flush=True)
+        yield None
+        return
 
     names = [name.cmd_vel[: -len("cmd_vel")].rstrip("/") or robot.name or "robot"
              for name, robot in zip(stage.names, stage.sim.robots, strict=True)]
