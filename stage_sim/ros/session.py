@@ -22,6 +22,8 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
+from stage_sim.bags.errors import BagError
+from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
@@ -114,6 +116,7 @@ def parse_args(argv: list[str], prog: str, default_world: str, description: str)
     parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")
     parser.add_argument("--seed", type=int, default=None, help="seed of the simulator and the wanderers")
     add_record_arguments(parser)
+    add_bag_arguments(parser)
     add_view_options(parser)
     return parser.parse_args(argv)
 
@@ -128,12 +131,13 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     try:
         with stop_requests() as stop:
             session = WanderSession(args.world, args.speedup, args.seed)
-            with recording(session.stage, args, prog), viewing(session.stage, args):
+            with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog),
+                  viewing(session.stage, args)):
                 session.run(args.duration, stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)
         return 0
-    except (WorldError, FileNotFoundError, ValueError) as error:
+    except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

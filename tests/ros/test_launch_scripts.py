@@ -126,3 +126,17 @@ def _readable(fd: int) -> bool:
     import select
 
     return bool(select.select([fd], [], [], 0.1)[0])
+
+
+def test_bag_records_the_session_and_the_summaries_still_print(tmp_path: Path) -> None:
+    from tests.bags.readers import read_with_rosbags
+
+    bag = tmp_path / "wander.mcap"
+    result = run_script("multi_reactive.py", "--duration", "3", "--speedup", "0", "--seed", "1", "--bag", str(bag),
+                        cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert len(summaries(result.stdout)) == 4
+    counts = read_with_rosbags(bag).counts()
+    assert counts["/clock"] == 30
+    for robot in range(4):  # every robot's scans and odometry, one message per step
+        assert counts[f"/robot_{robot}/base_scan"] == counts[f"/robot_{robot}/odom"] == 30
