@@ -8,8 +8,11 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+from stage_sim.worldfile import bitmap_files, syntax
+from stage_sim.worldfile.bundled import bundled_worlds, find_world
 from stage_sim.worldfile.errors import SourceLocation, WorldError
 from stage_sim.worldfile.loader import load_world
+from stage_sim.worldfile.search_path import candidate_paths
 from stage_sim.worldfile.syntax import parse_world
 
 BASE = "define base position ( size [0.3 0.3 0.2] drive \"omni\" )\n"
@@ -111,3 +114,14 @@ def test_missing_bitmap_names_every_place_tried(tmp_path: Path, monkeypatch: pyt
         load_world(world)
     assert info.value.location == SourceLocation(str(world), 2, 3)
     assert f"tried {tmp_path / 'world' / 'maps' / 'none.png'}, {tmp_path / 'maps' / 'none.png'}" in str(info.value)
+
+
+@pytest.mark.parametrize("world", bundled_worlds())
+def test_bundled_worlds_load_by_stages_rule_alone(world: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The bundled worlds load in the real Stage too: every include and bitmap is found beside the world file."""
+    def stage_place_only(name: str, world_file: Path, written_in: Path) -> list[Path]:
+        return candidate_paths(name, world_file, written_in)[:1]
+
+    monkeypatch.setattr(syntax, "candidate_paths", stage_place_only)
+    monkeypatch.setattr(bitmap_files, "candidate_paths", stage_place_only)
+    assert load_world(find_world(world)).models
