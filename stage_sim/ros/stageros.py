@@ -244,6 +244,7 @@ class StageRos(Node):
         true_velocity = fields.ground_truth_velocities(sim)
         # A message nobody has subscribed to is neither filled nor serialised (asking DDS costs ~1.5 µs, a
         # publish 15-80 µs): with a hundred robots most topics have no reader, and lockstep runs go 2x faster.
+        tf_wanted = self.tf_pub.get_subscription_count() > 0
         for i, out in enumerate(self._out):
             odom = sim.odometry_poses[i]
             if self.odom_pubs[i].get_subscription_count():
@@ -254,9 +255,10 @@ class StageRos(Node):
             if self.stall_pubs[i].get_subscription_count():
                 out.stall.data = bool(sim.stalled[i])
                 self.stall_pubs[i].publish(out.stall)
-            conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
+            if tf_wanted:
+                conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
             for scan, pub, msg in zip(sim.scans[i], self.scan_pubs[i], out.scans, strict=True):
                 if fields.is_fresh(scan, sim) and pub.get_subscription_count():
                     pub.publish(conversions.fill_scan(msg, scan, time))
-        if self.tf_pub.get_subscription_count():
+        if tf_wanted:
             self.tf_pub.publish(self._tf)

@@ -56,7 +56,7 @@ class Probe:
         self.node.create_subscription(msg_type, topic, self.messages[topic].append, qos)
         return self.messages[topic]
 
-    def wait(self, topic: str, count: int = 1, timeout_s: float = 5.0) -> list:
+    def wait(self, topic: str, count: int = 1, timeout_s: float = 15.0) -> list:  # discovery under load
         assert spin_until(self.executor, lambda: len(self.messages[topic]) >= count, timeout_s), topic
         return self.messages[topic]
 
