@@ -4,11 +4,9 @@
 [--core]`` runs ``launch_scripts/reactive.py W --duration 60*M --speedup 0 --seed s -g`` (lockstep, no view)
 for seeds S..S+N-1, J processes at a time (default: one per core). Each run picks its own private ROS domain
 (ROS_DOMAIN_ID is removed from their environment), so runs never hear each other. ``--core`` runs the same
-sessions without ROS: the core simulation stepped as the lockstep session steps it, with the core
-WanderDriver (which hands each wanderer exactly what the ``wander`` node receives, so a seed gives the same
-commands and summaries as through the nodes, for less CPU: no DDS, no messages). Prints one JSON line per
-seed and robot, then one summary line per world; a seed falls short with a stall event, a stop over 3 s or
-coverage under 0.95. Exit status 1 when a run fails or a seed falls short.
+sessions without ROS (:mod:`stage_sim.runs.wander_run`: the same summaries seed for seed, for less CPU).
+Prints one JSON line per seed and robot, then one summary line per world; a seed falls short with a stall
+event, a stop over 3 s or coverage under 0.95. Exit status 1 when a run fails or a seed falls short.
 """
 
 from __future__ import annotations
@@ -46,11 +44,8 @@ def run_seed(world: str, seed: int, minutes: float) -> dict:
 
 
 def run_core_seed(world: str, seed: int, minutes: float) -> dict:
-    """The same session without ROS, in this process: each step of the world, then each wanderer's answer
-    to its new scan (the lockstep session's order; the sim's watchdog as stageros sets it)."""
-    from stage_sim.runs.driver import WanderDriver
-    from stage_sim.runs.stats import RunStats
-    from stage_sim.sim.simulation import Simulation
+    """The same session without ROS, in this process (:mod:`stage_sim.runs.wander_run`)."""
+    from stage_sim.runs.wander_run import wander_summaries
     from stage_sim.worldfile.bundled import find_world
     from stage_sim.worldfile.errors import WorldError
     from stage_sim.worldfile.loader import load_world
@@ -60,18 +55,8 @@ def run_core_seed(world: str, seed: int, minutes: float) -> dict:
         description = load_world(find_world(world))
     except (WorldError, FileNotFoundError, ValueError) as error:
         return {"seed": seed, "wall_s": 0.0, "returncode": 2, "error": [str(error)]}
-    sim = Simulation(description, seed=seed, watchdog_timeout=0.2)
-    driver, stats = WanderDriver(sim, seed), RunStats(sim)
-    end = minutes * 60
-    if description.settings.quit_time > 0:
-        end = min(end, description.settings.quit_time)
-    while sim.sim_time < end - 1e-9:
-        sim.step()
-        stats.update()
-        driver.decide()
-    names = [robot.name or f"robot_{robot.index}" for robot in sim.robots]
-    return {"seed": seed, "wall_s": round(time.monotonic() - start, 1), "returncode": 0,
-            "robots": stats.summaries(names)}
+    robots = wander_summaries(description, seed, minutes * 60)
+    return {"seed": seed, "wall_s": round(time.monotonic() - start, 1), "returncode": 0, "robots": robots}
 
 
 def falls_short(robot: dict) -> bool:
