@@ -9,7 +9,7 @@ from rclpy.executors import Executor
 
 
 def spin_until(
-    executor: Executor, condition: Callable[[], bool], timeout_s: float = 5.0
+    executor: Executor, condition: Callable[[], bool], timeout_s: float = 10.0
 ) -> bool:
     """Spin until ``condition()`` holds or ``timeout_s`` wall seconds pass; returns the condition."""
     deadline = time.monotonic() + timeout_s
