@@ -25,6 +25,7 @@ ODOM_DRIFT = (0.02, 0.03)  # allowance per metre driven and per radian of net tu
 MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free space for a point to be moving
 SLOW_SCANS = 5  # scans back (0.5 s at 10 Hz) of the scan that near points are also held against
 SLOW_RANGE = 1.5  # m: points this near are checked for slow movers (farther ones cannot reach the body in time)
+SLOW_CONFIRM = 0.1  # m: a slow mover counts when the previous scan found one this near it too
 
 
 class ObstacleMemory:
@@ -35,6 +36,7 @@ class ObstacleMemory:
         self._memory = np.zeros((0, 4))  # x, y (odometry frame), odometry travel and turn when seen
         # The latest scans, oldest first: laser pose (odometry frame) and ranges (misses at range_max).
         self._scans: deque[tuple] = deque(maxlen=SLOW_SCANS)
+        self._slow = np.zeros((0, 2))  # where the previous scan found slow movers (odometry frame)
 
     def update(
         self, reading: LaserReading, pose: tuple[float, float, float], odometry: np.ndarray
@@ -62,8 +64,10 @@ class ObstacleMemory:
 
     def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
         """Per beam: whether it hits something where the previous scan saw free space (its beam, or a
-        neighbour, reached further), or, within SLOW_RANGE, where the scan SLOW_SCANS back did: something
-        that moved in, such as another robot."""
+        neighbour, reached further), or, within SLOW_RANGE, where the scan SLOW_SCANS back did and the
+        previous scan found the same: something that moved in, such as another robot. (A wall seen from two
+        poses can pass the second test once, by quantisation: a robot turning to and fro between those poses
+        would take it for a mover every other scan and dither for ever; a real mover passes it every scan.)"""
         ranges = np.asarray(reading.ranges, dtype=np.float64)
         x, y, yaw = reading.laser_pose
         here = (pose[0] + math.cos(pose[2]) * x - math.sin(pose[2]) * y,
@@ -75,10 +79,20 @@ class ObstacleMemory:
             end = np.stack([here[0] + ranges * np.cos(angles), here[1] + ranges * np.sin(angles)], axis=-1)
             nearer = hits & _inside_free_space(end, reading, *self._scans[-1])
             if len(self._scans) == SLOW_SCANS:
-                nearer |= hits & (ranges < SLOW_RANGE) & _inside_free_space(end, reading, *self._scans[0])
+                slow = hits & (ranges < SLOW_RANGE) & _inside_free_space(end, reading, *self._scans[0])
+                nearer |= slow & _near_any(end, self._slow, SLOW_CONFIRM)
+                self._slow = end[slow]
         self._scans.append((here, np.where(hits, ranges, reading.range_max)))
         nearer = np.concatenate([[False], nearer, [False]])
         return nearer[1:-1] & (nearer[:-2] | nearer[2:])  # a lone beam is an edge effect, not a body
+
+
+def _near_any(points: np.ndarray, others: np.ndarray, reach: float) -> np.ndarray:
+    """Per point: whether any of ``others`` lies within ``reach`` of it."""
+    if not len(points) or not len(others):
+        return np.zeros(len(points), dtype=bool)
+    gaps = np.hypot(points[:, None, 0] - others[None, :, 0], points[:, None, 1] - others[None, :, 1])
+    return gaps.min(axis=1) < reach
 
 
 def _inside_free_space(end: np.ndarray, reading: LaserReading, laser: tuple, before: np.ndarray) -> np.ndarray:

@@ -23,9 +23,17 @@ def robot_rear(x: float) -> list[tuple[float, float, float, float]]:
 def test_a_robot_backing_in_at_walking_pace_is_moving_once_half_a_second_shows_it() -> None:
     memory = ObstacleMemory(radius=1.5)
     flags = [moving_flags(memory, robot_rear(1.0 - 0.015 * k)) for k in range(SLOW_SCANS + 2)]
-    # 15 mm per scan is within the per-scan quantisation margin: only the scan of half a second ago tells.
-    assert not any(f.any() for f in flags[:SLOW_SCANS])
-    assert flags[SLOW_SCANS].all() and flags[SLOW_SCANS + 1].all()
+    # 15 mm per scan is within the per-scan quantisation margin: only the scan of half a second ago tells,
+    # and the next scan confirms it.
+    assert not any(f.any() for f in flags[: SLOW_SCANS + 1])
+    assert flags[SLOW_SCANS + 1].all()
+
+
+def test_a_wall_nearer_than_half_a_second_ago_for_one_scan_only_is_no_mover() -> None:
+    """What quantisation does to a wall seen from two poses in turn: it must not stop a robot turning to and fro."""
+    memory = ObstacleMemory(radius=1.5)
+    walls = [1.0] * SLOW_SCANS + [0.98, 0.96, 1.0, 0.98, 0.96, 1.0]
+    assert not any(moving_flags(memory, robot_rear(x)).any() for x in walls)
 
 
 def test_a_slow_robot_beyond_the_slow_range_is_not_flagged() -> None:
