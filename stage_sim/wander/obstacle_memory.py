@@ -5,8 +5,9 @@ sector; so the nearby points that have left the field of view are kept, in the o
 safety allowance that grows with the odometry error accumulated since it was seen (metres driven, radians
 turned), and forgotten once that allowance is too large to plan with. Points where the previous scan saw
 free space are flagged as moving: something came in, such as another robot. Near points are also held
-against the scan of SLOW_SCANS scans ago: a robot reversing blind at 0.15 m/s moves too little from one scan
-to the next to be told from sensor quantisation, yet would run into a robot that took it for a wall.
+against the scan of SLOW_SCANS scans ago (and must pass that twice in a row): a robot reversing blind at
+0.15 m/s moves too little from one scan to the next to be told from sensor quantisation, yet would run into
+a robot that took it for a wall.
 """
 
 from __future__ import annotations
