@@ -77,7 +77,7 @@ class WanderSession:
 
     def summaries(self) -> list[dict]:
         """The per-robot JSON summaries, named after the robots' models."""
-        return self.stats.summaries([robot.name or f"robot_{robot.index}" for robot in self.stage.sim.robots])
+        return self.stats.summaries()
 
     def close(self) -> None:
         """Stop the robots and destroy every node."""

@@ -100,8 +100,11 @@ class RunStats:
         for robot in range(len(poses)):
             self._stamp(robot)
 
-    def summaries(self, names: list[str]) -> list[dict]:
-        """One JSON-ready summary per robot, in robot order."""
+    def summaries(self, names: list[str] | None = None) -> list[dict]:
+        """One JSON-ready summary per robot, in robot order, named ``names`` (default: after the robots' models,
+        ``robot_<i>`` for an unnamed one, as the launch scripts print them)."""
+        if names is None:
+            names = [robot.name or f"robot_{robot.index}" for robot in self.sim.robots]
         free = int(self.free.sum())
         return [
             {

@@ -30,4 +30,4 @@ def wander_summaries(description: WorldDescription, seed: int | None, seconds: f
         sim.step()
         stats.update()
         driver.decide()
-    return stats.summaries([robot.name or f"robot_{robot.index}" for robot in sim.robots])
+    return stats.summaries()
