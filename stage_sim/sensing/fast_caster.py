@@ -75,7 +75,7 @@ class NumbaRayCaster:
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
         args = (self._world, layer, flags, self._place, np.ascontiguousarray(xy), cosa, sina,
-                np.ascontiguousarray(rmax), 1.0 / self.resolution, own, ranges, cell, hit_robot)
+                rmax, 1.0 / self.resolution, own, ranges, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
             traversal.cast_parallel(*args)

@@ -101,10 +101,16 @@ def ray_arguments(
     broadcast to N (owners −1 when not given), so that the two kernels read identical inputs."""
     xy = np.asarray(origins_xy, dtype=np.float64).reshape(-1, 2)
     n = xy.shape[0]
-    ang = np.broadcast_to(np.asarray(angles, dtype=np.float64), (n,))
-    rmax = np.broadcast_to(np.asarray(max_ranges, dtype=np.float64), (n,))
-    own = np.ascontiguousarray(np.broadcast_to(np.asarray(-1 if owners is None else owners, dtype=np.int64), (n,)))
-    return xy, ang, rmax, own
+    return xy, _per_ray(angles, n, np.float64), _per_ray(max_ranges, n, np.float64), _per_ray(
+        -1 if owners is None else owners, n, np.int64)
+
+
+def _per_ray(value: np.ndarray | float, n: int, dtype: type) -> np.ndarray:
+    """``value`` as a contiguous array of ``n`` entries of ``dtype``: as it is when it already is one (the
+    simulation's own calls, once per step, where broadcasting would cost more than the cast of a scan)."""
+    if isinstance(value, np.ndarray) and value.dtype == dtype and value.shape == (n,) and value.flags.c_contiguous:
+        return value
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=dtype), (n,)))
 
 
 def beam_cos_sin(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

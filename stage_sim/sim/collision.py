@@ -29,7 +29,10 @@ def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """World coordinates of body points (P, 2), each given with the pose (P, 3) of its robot."""
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     px, py = points[:, 0], points[:, 1]
-    return np.stack([poses[:, 0] + c * px - s * py, poses[:, 1] + s * px + c * py], axis=-1)
+    out = np.empty((len(poses), 2))  # filled column by column: np.stack costs more than this for a few points
+    out[:, 0] = poses[:, 0] + c * px - s * py
+    out[:, 1] = poses[:, 1] + s * px + c * py
+    return out
 
 
 @dataclass
@@ -89,6 +92,8 @@ class CollisionChecker:
         self._layers = layers
         self._layer_of_robot = layer_of_robot
         self._collides = collides
+        self._robots_can_clash = int(np.count_nonzero(collides)) > 1
+        self._in_layer = [layer_of_robot == i for i in range(len(layers))]  # per layer: its robots (N,)
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
@@ -98,12 +103,14 @@ class CollisionChecker:
         self._table = (np.full(size, -1, dtype=np.int64), np.empty(size, dtype=np.int64),
                        np.empty(max(points, 1), dtype=np.int64))
 
-    def resolve(self, poses: np.ndarray, velocities: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    def resolve(
+        self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Move every robot by one step; returns (new poses, refused) with refused moves undone.
 
-        Robots with zero velocity do not move and are never refused here; the caller keeps their previous
-        stall flag, as Stage does."""
-        moving = np.any(velocities != 0.0, axis=1)
+        Robots with zero velocity (``moving`` False, computed when not given) do not move and are never
+        refused here; the caller keeps their previous stall flag, as Stage does."""
+        moving = np.any(velocities != 0.0, axis=1) if moving is None else moving
         refused = np.zeros(len(poses), dtype=bool)
         movers = np.flatnonzero(moving & self._collides)
         if self.grid.kernels == "numba":
@@ -114,6 +121,8 @@ class CollisionChecker:
             if movers.size:
                 refused[movers] = self._hits_static(poses, velocities, dt, movers)
         final = np.where(refused[:, None], poses, candidates)
+        if not self._robots_can_clash:
+            return final, refused
         for _ in range(MAX_CONFLICT_ROUNDS):
             conflict = self._robot_conflicts(final) & moving & ~refused
             if not conflict.any():
@@ -192,7 +201,7 @@ class CollisionChecker:
             grid = layer.grid
             sweep_kernels.static_hits(
                 self.bodies.points, self._point_start, self._point_count, x, y, cos_p, sin_p, robot,
-                self._layer_of_robot == i, self.grid.resolution, *self.grid.origin_xy, *self.grid.shape, grid.slots,
+                self._in_layer[i], self.grid.resolution, *self.grid.origin_xy, *self.grid.shape, grid.slots,
                 grid.place, layer.tile_of_slot, layer.bits, hit)
         refused[movers] = hit[movers]
         return candidates

@@ -167,10 +167,11 @@ class RangerSensing:
         static_hit = result.hit_cell >= 0
         hits = np.zeros(len(rays), dtype=np.float32)
         hits[static_hit] = group.intensity.at(result.hit_cell[static_hit])
-        robot_hit = result.hit_robot >= 0
-        hits[robot_hit] = group.robot_return[result.hit_robot[robot_hit]]
-        # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
-        hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
+        if self._bodies.count > 1:  # a lone robot never sees itself
+            robot_hit = result.hit_robot >= 0
+            hits[robot_hit] = group.robot_return[result.hit_robot[robot_hit]]
+            # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
+            hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
         intensity[rays] = hits
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:

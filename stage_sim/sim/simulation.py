@@ -160,8 +160,8 @@ class Simulation:
             silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
-        moved, refused = self._collision.resolve(self.true_poses, self.velocities, dt)
         moving = np.any(self.velocities != 0.0, axis=1)
+        moved, refused = self._collision.resolve(self.true_poses, self.velocities, dt, moving)
         self.stalled = np.where(moving, refused, self.stalled)
         self.true_poses = moved
         self.odometry_poses = self._odometry(moved, dt)
