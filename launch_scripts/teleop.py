@@ -19,12 +19,12 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
 from stage_sim.ros.domain import use_private_domain
-from stage_sim.ros.interrupts import sigterm_interrupts
 from stage_sim.ros.recording import recording
 from stage_sim.ros.session import parse_args
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.teleop import KeyReader, TeleopTwistKeyboard
 from stage_sim.ros.view import viewing
+from stage_sim.runs.interrupts import sigterm_interrupts
 from stage_sim.worldfile.errors import WorldError
 
 

@@ -18,6 +18,7 @@ from typing import Any
 
 from stage_sim.cli.arguments import positive, resolve_world
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
+from stage_sim.runs.interrupts import stop_requests
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,15 +63,16 @@ def _run(args: argparse.Namespace) -> int:
     drive = CONTROLLERS[args.controller](sim, args.seed)
     start = time.monotonic()
     try:
-        while sim.sim_time < end - 1e-9 and not (recorder and recorder.failed):
-            drive()
-            sim.step()
-            if recorder:
-                recorder.record_step()
-            if speedup > 0:
-                time.sleep(max(0.0, start + sim.sim_time / speedup - time.monotonic()))
-    except KeyboardInterrupt:
-        print(f"stage_sim run: interrupted at sim time {sim.sim_time:g} s", file=sys.stderr)
+        with stop_requests() as stop:  # Ctrl-C and SIGTERM end the run between steps
+            while sim.sim_time < end - 1e-9 and not (recorder and recorder.failed) and not stop.is_set():
+                drive()
+                sim.step()
+                if recorder:
+                    recorder.record_step()
+                if speedup > 0:
+                    stop.wait(max(0.0, start + sim.sim_time / speedup - time.monotonic()))
+        if stop.is_set():
+            print(f"stage_sim run: interrupted at sim time {sim.sim_time:g} s", file=sys.stderr)
     finally:
         summary = recorder.close() if recorder else None
     wall = time.monotonic() - start

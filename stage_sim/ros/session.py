@@ -25,12 +25,12 @@ from rclpy.signals import SignalHandlerOptions
 from stage_sim.bags.errors import BagError
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.domain import use_private_domain
-from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.ros.wander import Wander
 from stage_sim.runs.driver import wanderer_seed
+from stage_sim.runs.interrupts import stop_requests
 from stage_sim.runs.stats import RunStats
 from stage_sim.worldfile.errors import WorldError
 

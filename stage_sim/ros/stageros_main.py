@@ -24,9 +24,9 @@ from rclpy.utilities import remove_ros_args
 from stage_sim.bags.errors import BagError
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.core_log import core_log_on
-from stage_sim.ros.interrupts import stop_requests
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.view import add_view_options, viewing
+from stage_sim.runs.interrupts import stop_requests
 from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.worldfile.bundled import bundled_worlds
 from stage_sim.worldfile.errors import WorldError

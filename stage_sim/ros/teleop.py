@@ -31,7 +31,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from stage_sim.ros.interrupts import sigterm_interrupts
+from stage_sim.runs.interrupts import sigterm_interrupts
 
 NODE_NAME = "teleop_twist_keyboard"  # the original's name, so its parameter files apply unchanged
 QUIT_KEY = "\x03"

@@ -31,7 +31,7 @@ from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import LaserScan
 from tf2_msgs.msg import TFMessage
 
-from stage_sim.ros.interrupts import stop_requests
+from stage_sim.runs.interrupts import stop_requests
 from stage_sim.wander.config import WanderConfig
 from stage_sim.wander.laser_reading import LaserReading
 from stage_sim.wander.reactive import Wanderer
