@@ -67,7 +67,7 @@ def test_a_robot_standing_in_a_doorway_is_kept_further_from_than_the_jambs() -> 
     """A robot in a doorway leaves what looks like a narrow door beside it; passing at the walls' margin leaves
     nothing to spare when it backs up or turns (multi_robots.world seeds 14 and 19)."""
     wall = [(1.5, -3.0, 1.5, -0.55), (1.5, 0.55, 1.5, 3.0)]  # a 1.1 m doorway 1.5 m ahead
-    points, allowance = allowances([*wall, (1.4, 0.0, 1.4, 0.3), (1.4, 0.3, 1.86, 0.3)])  # a robot inside it
+    points, allowance = allowances(wall + [(1.4, 0.0, 1.4, 0.3), (1.4, 0.3, 1.86, 0.3)])  # a robot inside it
     robot = (np.abs(points[:, 0] - 1.4) < 0.01) & (points[:, 1] >= 0.0) & (points[:, 1] <= 0.3)
     assert robot.sum() >= 3
     np.testing.assert_allclose(allowance[robot], ISLAND_MARGIN)
