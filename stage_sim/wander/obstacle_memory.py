@@ -27,9 +27,6 @@ MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free 
 SLOW_SCANS = 5  # scans back (0.5 s at 10 Hz) of the scan that near points are also held against
 SLOW_RANGE = 1.5  # m: points this near are checked for slow movers (farther ones cannot reach the body in time)
 SLOW_CONFIRM = 0.1  # m: a slow mover counts when the previous scan found one this near it too
-ISLAND_WIDTHS = (0.2, 0.6)  # m: a run of hits this wide (a robot's side or end, not a thin wall's end face)
-ISLAND_JUMP = 0.3  # m the beams on both sides of such a run reach beyond it
-ISLAND_MARGIN = 0.08  # m of allowance for points on such an island: it may be a robot, and robots back up blind
 
 
 class ObstacleMemory:
@@ -49,7 +46,6 @@ class ObstacleMemory:
         and which of them are moving (nearer than the last scan put anything along their beam)."""
         seen, beams = reading.points(), reading.hits()
         moving = self._approaching(reading, pose)[beams]
-        island = reading.islands(ISLAND_WIDTHS, ISLAND_JUMP)[beams]
         remembered = compose(pose, self._memory[:, :2], inverse=True)
         keep = reading.outside_view(remembered)
         points = np.concatenate([seen, remembered[keep]])
@@ -59,14 +55,13 @@ class ObstacleMemory:
         allowance = drift[:, 0] + drift[:, 1] * distance
         trusted = allowance <= MAX_ALLOWANCE
         moving = np.concatenate([moving, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
-        island = np.concatenate([island, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
         points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
         near = distance < self.radius
         world = compose(pose, points[near])
         unique = first_per_cell(world, MEMORY_CELL)
         unique.sort()  # the first of a cell is the freshest
         self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
-        return points, allowance + ISLAND_MARGIN * island, moving
+        return points, allowance, moving
 
     def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
         """Per beam: whether it hits something where the previous scan saw free space (its beam, or a

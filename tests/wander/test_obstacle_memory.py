@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stage_sim.wander.obstacle_memory import ISLAND_MARGIN, SLOW_RANGE, SLOW_SCANS, ObstacleMemory
+from stage_sim.wander.obstacle_memory import SLOW_RANGE, SLOW_SCANS, ObstacleMemory
 from tests.wander.test_reactive import scan_of_segments
 
 ODOMETRY = np.zeros(2)
@@ -56,24 +56,3 @@ def test_a_robot_crossing_at_speed_is_moving_from_the_next_scan() -> None:
     memory = ObstacleMemory(radius=1.5)
     moving_flags(memory, robot_rear(2.0))
     assert moving_flags(memory, robot_rear(1.9)).all()
-
-
-def allowances(segments: list) -> tuple[np.ndarray, np.ndarray]:
-    points, allowance, _ = ObstacleMemory(radius=1.5).update(scan_of_segments(segments), (0.0, 0.0, 0.0), ODOMETRY)
-    return points, allowance
-
-
-def test_a_robot_standing_in_a_doorway_is_kept_further_from_than_the_jambs() -> None:
-    """A robot in a doorway leaves what looks like a narrow door beside it; passing at the walls' margin leaves
-    nothing to spare when it backs up or turns (multi_robots.world seeds 14 and 19)."""
-    wall = [(1.5, -3.0, 1.5, -0.55), (1.5, 0.55, 1.5, 3.0)]  # a 1.1 m doorway 1.5 m ahead
-    points, allowance = allowances(wall + [(1.4, 0.0, 1.4, 0.3), (1.4, 0.3, 1.86, 0.3)])  # a robot inside it
-    robot = (np.abs(points[:, 0] - 1.4) < 0.01) & (points[:, 1] >= 0.0) & (points[:, 1] <= 0.3)
-    assert robot.sum() >= 3
-    np.testing.assert_allclose(allowance[robot], ISLAND_MARGIN)
-    np.testing.assert_allclose(allowance[~robot], 0.0)
-
-
-def test_walls_and_wall_ends_get_no_island_margin() -> None:
-    _, allowance = allowances([(1.5, -3.0, 1.5, -0.3), (1.5, 0.3, 1.5, 3.0), (0.5, 1.0, 3.0, 1.0)])
-    np.testing.assert_allclose(allowance, 0.0)
