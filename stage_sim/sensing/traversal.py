@@ -101,10 +101,13 @@ def _prefix(e, bx, by, mx, my, n):
     return _step_through(e, bx, by, mx, my, n)
 
 
-@numba.njit(**_JIT)
+@numba.njit(inline="always", **_JIT)
 def walk_ray(squares, tile_of_slot, slots, robot_regions, robot_ids, robot_blocks, block_squares, use_regions,
              use_robots, col0, row0, rcol0, rrow0, width, startx, starty, cosa, sina, tana, dx, dy, ppm, owner):
-    """(range in metres or inf, flat cell or -1, robot id or -1) of one ray walked as Stage walks it."""
+    """(range in metres or inf, flat cell or -1, robot id or -1) of one ray walked as Stage walks it.
+
+    Inlined into the loop over rays: a call passing seven arrays cost as much as a short ray's walk (1000
+    jammed robots: 72 → 51 ms per cast of 240,000 rays), for 5 s more of the one-off compilation."""
     rh, rw = slots.shape
     sx = 1 if dx > 0 else (-1 if dx < 0 else 0)
     sy = 1 if dy > 0 else (-1 if dy < 0 else 0)
