@@ -4,9 +4,9 @@ Same inputs, same :class:`~stage_sim.sensing.raycast.CastResult`, bit for bit (`
 cosines and sines of the angles come from the very numpy calls the reference makes, and the kernel computes
 the rest of Stage's per-ray constants (:class:`~stage_sim.sensing.stage_walk.WalkRays`) operation for operation.
 
-Memory: the static layer's free squares, 4 KB per tile (4 quadrants × uint8 per cell, only the world's
-regions holding a cell at this height: :mod:`stage_sim.maps.tiles`), the tile grid's region index (4 B per
-region) shared with the world, and the robot layer (:class:`~stage_sim.sensing.robot_layer.RobotLayer`).
+Memory: the static layer's bit rows and columns, 256 B per tile (only the world's regions holding a cell at
+this height: :mod:`stage_sim.maps.tiles`), the tile grid's region index (4 B per region) shared with the
+world, and the robot layer (:class:`~stage_sim.sensing.robot_layer.RobotLayer`).
 """
 
 from __future__ import annotations
@@ -15,14 +15,10 @@ import numpy as np
 
 from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing import traversal
-from stage_sim.sensing.distance_field import tile_square_fields
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import beam_cos_sin, free_squares, ray_arguments, static_layer
-
-#: Static tiles up to which the free squares are computed by numpy (about 0.1 s).
-NUMPY_SQUARE_TILES = 2048
+from stage_sim.sensing.stage_walk import beam_cos_sin, ray_arguments, static_layer
 
 
 class NumbaRayCaster:
@@ -44,13 +40,11 @@ class NumbaRayCaster:
         self.height, self.width = layer.grid.shape
         self.threads = threads
         self._grid = layer.grid
-        # numpy computes the squares of an ordinary world as fast as loading the compiled function would take
-        # (and without its few MB); a large world's are computed compiled (identical fields)
-        compute = traversal.tile_square_fields if layer.bits.shape[0] > NUMPY_SQUARE_TILES else tile_square_fields
-        self._world = (free_squares(layer, compute), layer.tile_of_slot, layer.grid.slots)
+        rows, cols = bit_rows_and_columns(layer)
+        self._world = (rows, cols, layer.tile_of_slot, layer.grid.slots)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
-                           np.full((1, 1, 1), -1, dtype=np.int32), np.zeros((1, 1, 1, 1), dtype=np.uint8))
+                           np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32))
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
@@ -69,7 +63,7 @@ class NumbaRayCaster:
         n = xy.shape[0]
         cosa, sina = beam_cos_sin(ang)
         layer = (self._no_robots if robots is None else
-                 (robots.regions, robots.ids, robots.blocks, robots.block_squares))
+                 (robots.regions, robots.ids, robots.rows, robots.cols))
         flags = (robots is not None, robots is not None and robots.active)
         ranges = np.empty(n)
         cell = np.empty(n, dtype=np.int64)
@@ -82,3 +76,18 @@ class NumbaRayCaster:
         else:
             traversal.cast_serial(*args)
         return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
+
+
+def bit_rows_and_columns(layer: TileLayer) -> tuple[np.ndarray, np.ndarray]:
+    """(T, 32) uint32 row masks (bit x of row y: cell (y, x)) and column masks (bit y of column x) of the
+    layer's tiles, computed the first time only and kept with the layer (the casters of two heights that see
+    the same cells share them)."""
+    if "bit_rows" not in layer.derived:
+        bits = np.ascontiguousarray(layer.bits)
+        rows = bits.view("<u4").reshape(bits.shape[0], bits.shape[1]).astype(np.uint32)
+        weights = np.uint32(1) << np.arange(rows.shape[1], dtype=np.uint32)
+        cols = np.empty_like(rows)
+        for x in range(rows.shape[1]):  # column x: bit y is bit x of row y
+            cols[:, x] = ((rows >> np.uint32(x)) & np.uint32(1)) @ weights
+        layer.derived["bit_rows"] = (rows, cols)
+    return layer.derived["bit_rows"]

@@ -70,7 +70,7 @@ class CastResult:
 def walk_prefix(e0, bx, by, mx, my, n):
     """(i, j) arrays: the most x-steps (<= mx) and y-steps (<= my), i + j <= n, the walk takes from error e0.
 
-    The vectorised twin of :func:`stage_sim.sensing.traversal.walk_prefix` (integer arithmetic only).
+    Where the walk stands after a free stretch, in closed form (integer arithmetic only).
     """
     safe_bx = np.maximum(bx, 1)
     room = my * bx - e0

@@ -50,11 +50,12 @@ def number_robot_regions(regions, old, rows, cols, ids, visible, place, width, m
 
 
 @numba.njit(**_JIT)
-def write_robot_tiles(cell_ids, blocks, tile, local, ids, count, several, block_bits):
-    """Clear tiles 0…count-1, then write robot ``ids[i]`` into its cell and its block (``several`` where two
-    robots meet); returns whether any cell was written."""
+def write_robot_tiles(cell_ids, rows, cols, tile, local, ids, count, several):
+    """Clear tiles 0…count-1, then write robot ``ids[i]`` into its cell (``several`` where two robots meet)
+    and its bit into the row and column masks; returns whether any cell was written."""
     cell_ids[:count] = -1
-    blocks[:count] = -1
+    rows[:count] = 0
+    cols[:count] = 0
     written = False
     for i in range(tile.size):
         t = tile[i]
@@ -65,7 +66,6 @@ def write_robot_tiles(cell_ids, blocks, tile, local, ids, count, several, block_
         y, x = local[i] >> TILE_BITS, local[i] & (TILE - 1)
         seen = cell_ids[t, y, x]
         cell_ids[t, y, x] = robot if seen == -1 or seen == robot else several
-        by, bx = y >> block_bits, x >> block_bits
-        seen = blocks[t, by, bx]
-        blocks[t, by, bx] = robot if seen == -1 or seen == robot else several
+        rows[t, y] |= np.uint32(1) << np.uint32(x)
+        cols[t, x] |= np.uint32(1) << np.uint32(y)
     return written

@@ -1,16 +1,19 @@
-"""Robots as ray obstacles: an id per cell in tiles allocated where robots are, and robot-free squares of blocks.
+"""Robots as ray obstacles: an id per cell in tiles allocated where robots are, and what lets a walk cross them.
 
 A ray's walk (:mod:`stage_sim.sensing.stage_walk`) hits a robot when it stands in a cell covered by a robot
 other than its owner, exactly as it hits a static cell. Robot cells live in tiles of the world's regions
 (:mod:`stage_sim.maps.tiles`), allocated each step for the regions the visible robots' cells fall in. To
-let the walk cross robot-free space in one go, a tile is also cut into blocks of ``2**BLOCK`` cells a side:
-per block, which robot is there (-1 none, :data:`SEVERAL_ROBOTS` two or more), and per block and quadrant
-the largest square of robot-free blocks ahead of it within the tile
-(:func:`~stage_sim.sensing.distance_field.tile_square_fields` on the blocks). Both casters read this layer.
+let the walk cross robot-free space in one go, each caster gets what it reads besides the ids:
+
+* the numpy caster: a tile cut into blocks of ``2**BLOCK`` cells a side: per block, which robot is there
+  (-1 none, :data:`SEVERAL_ROBOTS` two or more), and per block and quadrant the largest square of robot-free
+  blocks ahead of it within the tile (:func:`~stage_sim.sensing.distance_field.tile_square_fields`);
+* the compiled caster: a 32-bit mask of the robot cells of every row and every column of a tile
+  (:mod:`stage_sim.sensing.traversal` tests a whole run of its walk against one).
 
 What it costs: the region index, int32 per region (4 B per 1024 cells of the world's bounding box); per
-tile in use 4 KB of ids (int32 per cell), 64 B of block owners and 64 B of block squares. Each update
-touches only the cells the robots cover (O(robot cells), no sort).
+tile in use 4 KB of ids (int32 per cell) and 128 B of block owners and squares (numpy) or 256 B of masks
+(compiled). Each update touches only the cells the robots cover (O(robot cells), no sort).
 """
 
 from __future__ import annotations
@@ -72,6 +75,8 @@ class RobotLayer:
         self.ids = np.full((0, TILE, TILE), -1, dtype=np.int32)  #: (T, 32, 32) robot id per cell
         self.blocks = np.full((0, TILE_BLOCKS, TILE_BLOCKS), -1, dtype=np.int32)  #: robot per 8 × 8 block
         self.block_squares = np.zeros((0, 4, TILE_BLOCKS, TILE_BLOCKS), dtype=np.uint8)
+        self.rows = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each row (compiled)
+        self.cols = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each column (compiled)
         self._marked = np.empty(0, dtype=np.int64)
         self.active = False
 
@@ -110,7 +115,7 @@ class RobotLayer:
         self.active = rows.size > 0
 
     def _update_compiled(self, cell_rows, cell_cols, robot_ids, visible) -> None:
-        from stage_sim.sensing import robot_kernels, traversal
+        from stage_sim.sensing import robot_kernels
 
         rows = np.asarray(cell_rows, dtype=np.int64).ravel()
         ids = np.asarray(robot_ids, dtype=np.int64).ravel()
@@ -119,16 +124,19 @@ class RobotLayer:
             self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(), ids, seen,
             self._place, self.shape[1], MARKED)
         self._reserve(count)
-        self.active = robot_kernels.write_robot_tiles(self.ids, self.blocks, tile, local, ids.astype(np.int32),
-                                                      count, SEVERAL_ROBOTS, BLOCK)
-        self.block_squares = traversal.tile_square_fields(self.blocks[:count] != -1)
+        self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, tile, local,
+                                                      ids.astype(np.int32), count, SEVERAL_ROBOTS)
 
     def _reserve(self, count: int) -> None:
         """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
         if count > self.ids.shape[0]:
             capacity = max(count, 2 * self.ids.shape[0])
             self.ids = np.empty((capacity, TILE, TILE), dtype=np.int32)
-            self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
+            if self.compiled:
+                self.rows = np.empty((capacity, TILE), dtype=np.uint32)
+                self.cols = np.empty((capacity, TILE), dtype=np.uint32)
+            else:
+                self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""

@@ -24,9 +24,10 @@ than the ray's own blocks it, as a static cell does.
 This module holds what both implementations share: the per-ray constants, computed by the same numpy
 calls for both, and the static layer in tiles of regions (:mod:`stage_sim.maps.tiles`). The walk itself
 runs in :mod:`stage_sim.sensing.traversal` (numba) and :mod:`stage_sim.sensing.raycast` (numpy), which
-must agree bit for bit. Both skip free space with
-free squares without changing an answer: every cell skipped is free, and the reported distance depends
-only on how many steps were taken along each axis since the last region jump (``base + count``).
+must agree bit for bit. Both cross free cells in groups without changing an answer (the numpy walk by
+free squares, the compiled one by runs of its line tested against bit masks): every cell crossed is free,
+and the reported distance depends only on how many steps were taken along each axis since the last region
+jump (``base + count``).
 """
 
 from __future__ import annotations
