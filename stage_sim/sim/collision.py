@@ -4,7 +4,9 @@ A robot's body is a cloud of outline points in its own frame (see :mod:`stage_si
 Placing all robots is one vectorised transform of all points; the cells they fall in are checked against
 the static collision layer (in tiles, :class:`~stage_sim.maps.tiles.TileLayer`) and against each other by
 the cells they share (sorted (cell, robot) pairs, or a hash table of the robots' cells in the compiled
-path: memory in proportion to the robots' cells, 16-32 B each, never to the world's area). As in Stage,
+path: memory in proportion to the robots' cells, 16-32 B each, never to the world's area). The cells of
+every body at the accepted poses are kept up to date through the rounds of refusals (only the refused
+robots' cells change) and handed to the lasers, which see the robots through the same cells. As in Stage,
 a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
 robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
 intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
@@ -97,6 +99,7 @@ class CollisionChecker:
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+        self._point_collides = collides[bodies.owner] if bodies.count else np.zeros(0, dtype=bool)
         # The compiled clash test's hash table: 24 B per slot, over twice the colliding robots' points.
         points = int(counts[collides].sum()) if len(collides) else 0
         size = 1 << max(1, (2 * points - 1).bit_length())
@@ -105,8 +108,9 @@ class CollisionChecker:
 
     def resolve(
         self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Move every robot by one step; returns (new poses, refused) with refused moves undone.
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Move every robot by one step; returns (new poses, refused, the cells of every body point at the new
+        poses, as :meth:`Bodies.point_cells`) with refused moves undone.
 
         Robots with zero velocity (``moving`` False, computed when not given) do not move and are never
         refused here; the caller keeps their previous stall flag, as Stage does."""
@@ -121,16 +125,21 @@ class CollisionChecker:
             if movers.size:
                 refused[movers] = self._hits_static(poses, velocities, dt, movers)
         final = np.where(refused[:, None], poses, candidates)
+        cells = self.bodies.point_cells(final, self.grid)
         if not self._robots_can_clash:
-            return final, refused
+            return final, refused, cells
         for _ in range(MAX_CONFLICT_ROUNDS):
-            conflict = self._robot_conflicts(final) & moving & ~refused
+            conflict = self._clashes(cells) & moving & ~refused
             if not conflict.any():
-                return final, refused
+                return final, refused, cells
             refused |= conflict
             final = np.where(refused[:, None], poses, candidates)
-        refused |= self._robot_conflicts(final) & moving
-        return np.where(refused[:, None], poses, candidates), refused
+            self._replace_cells(cells, final, np.flatnonzero(conflict))
+        last = self._clashes(cells) & moving & ~refused
+        refused |= last
+        final = np.where(refused[:, None], poses, candidates)
+        self._replace_cells(cells, final, np.flatnonzero(last))
+        return final, refused, cells
 
     def overlapping(self, poses: np.ndarray) -> np.ndarray:
         """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
@@ -138,7 +147,9 @@ class CollisionChecker:
         touching = np.zeros(len(poses), dtype=bool)
         if everyone.size:
             touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
-        return touching | self._robot_conflicts(poses)
+        if not self._robots_can_clash:
+            return touching
+        return touching | self._clashes(self.bodies.point_cells(poses, self.grid))
 
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
@@ -206,23 +217,33 @@ class CollisionChecker:
         refused[movers] = hit[movers]
         return candidates
 
-    def _robot_conflicts(self, poses: np.ndarray) -> np.ndarray:
-        """Robots whose bodies share a cell with another colliding robot at ``poses``."""
-        colliding = np.flatnonzero(self._collides)
-        conflict = np.zeros(len(poses), dtype=bool)
-        if colliding.size < 2:
-            return conflict
-        point_index, entry = self._points_of(colliding)
-        owner = colliding[entry]
-        cells = self.grid.body_cells(self.bodies.points[point_index], owner, poses)
+    def _replace_cells(self, cells: np.ndarray, poses: np.ndarray, robots: np.ndarray) -> None:
+        """Put the cells of ``robots``' points (entries of :meth:`Bodies.point_cells`) at ``poses`` into ``cells``."""
+        if not robots.size:
+            return
+        if self.grid.kernels == "numba":
+            from stage_sim.sim.collision_kernels import robots_cells
+
+            g = self.grid
+            robots_cells(self.bodies.points, self._point_start, self._point_count, robots, poses[:, 0].copy(),
+                         poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]), g.resolution, *g.origin_xy,
+                         *g.shape, cells)
+            return
+        point_index, entry = self._points_of(robots)
+        cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
+
+    def _clashes(self, cells: np.ndarray) -> np.ndarray:
+        """Colliding robots whose body points (``cells``, per body point) share a cell with another colliding
+        robot's."""
+        conflict = np.zeros(self.bodies.count, dtype=bool)
         if self.grid.kernels == "numba":
             from stage_sim.sim.collision_kernels import owner_clashes
 
-            owner_clashes(cells, owner, *self._table, conflict)
+            owner_clashes(cells, self.bodies.owner, self._point_collides, *self._table, conflict)
             return conflict
-        keep = cells >= 0
-        robots = np.int64(len(poses))
-        pairs = unique_sorted(cells[keep] * robots + owner[keep])  # each (cell, robot) once, by cell
+        keep = (cells >= 0) & self._point_collides
+        robots = np.int64(self.bodies.count)
+        pairs = unique_sorted(cells[keep] * robots + self.bodies.owner[keep])  # each (cell, robot) once, by cell
         shared = pairs[1:] // robots == pairs[:-1] // robots
         conflict[pairs[1:][shared] % robots] = True
         conflict[pairs[:-1][shared] % robots] = True

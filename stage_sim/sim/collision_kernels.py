@@ -31,17 +31,34 @@ def body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, w
 
 
 @numba.njit(**_JIT)
-def owner_clashes(cells, owner, keys, robot, used, conflict):
-    """Mark robots sharing a cell (-1: off the grid, ignored) in an open-addressing table of the cells seen
-    (``keys``, all -1, a power of two over twice the points; ``robot`` the first robot seen in each; ``used``
-    room for a slot per point): a later point of another robot in a cell flags both. The table is left
-    empty again. The numpy reference sorts (cell, robot) pairs instead."""
+def robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out):
+    """:func:`body_cells` of the points of ``robots`` only (robot r's points are ``first[r]`` on, ``count[r]``
+    of them), written into their entries of ``out``."""
+    for k in range(robots.size):
+        p = robots[k]
+        for i in range(first[p], first[p] + count[p]):
+            px = points[i, 0]
+            py = points[i, 1]
+            wx = x[p] + cos[p] * px - sin[p] * py
+            wy = y[p] + sin[p] * px + cos[p] * py
+            col = math.floor((wx - ox) / resolution)
+            row = math.floor((wy - oy) / resolution)
+            out[i] = row * width + col if 0 <= col < width and 0 <= row < height else -1
+
+
+@numba.njit(**_JIT)
+def owner_clashes(cells, owner, counted, keys, robot, used, conflict):
+    """Mark robots sharing a cell (-1: off the grid, ignored; only points with ``counted`` set take part) in
+    an open-addressing table of the cells seen (``keys``, all -1, a power of two over twice the points;
+    ``robot`` the first robot seen in each; ``used`` room for a slot per point): a later point of another
+    robot in a cell flags both. The table is left empty again. The numpy reference sorts (cell, robot) pairs
+    instead."""
     mask = keys.size - 1
     m = 0
     last_cell = last_owner = -1
     for i in range(cells.size):
         cell = cells[i]
-        if cell < 0 or (cell == last_cell and owner[i] == last_owner):
+        if cell < 0 or not counted[i] or (cell == last_cell and owner[i] == last_owner):
             continue
         last_cell, last_owner = cell, owner[i]
         slot = ((cell * 2654435761) >> 7) & mask

@@ -109,8 +109,9 @@ class RangerSensing:
         """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
         self._stale = True
 
-    def sense(self, poses: np.ndarray, time: float) -> None:
-        """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``."""
+    def sense(self, poses: np.ndarray, time: float, body_cells: np.ndarray | None = None) -> None:
+        """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``;
+        ``body_cells``: the robots' cells at ``poses`` when the caller has them (:meth:`Bodies.point_cells`)."""
         now_us = round(time * 1e6)
         due = ((now_us - self._last_us) >= self._interval_us) | self._stale
         self._stale = False
@@ -122,7 +123,9 @@ class RangerSensing:
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
-        robot_cells = self._bodies.point_cells(poses, self._grid) if self._bodies.count else None
+        robot_cells = None
+        if self._bodies.count:
+            robot_cells = self._bodies.point_cells(poses, self._grid) if body_cells is None else body_cells
         jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
         origins = place(self._ranger_offset, poses[self._ranger_owner])
         for group in self._groups:

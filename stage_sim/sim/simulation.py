@@ -161,11 +161,11 @@ class Simulation:
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
         moving = np.any(self.velocities != 0.0, axis=1)
-        moved, refused = self._collision.resolve(self.true_poses, self.velocities, dt, moving)
+        moved, refused, body_cells = self._collision.resolve(self.true_poses, self.velocities, dt, moving)
         self.stalled = np.where(moving, refused, self.stalled)
         self.true_poses = moved
         self.odometry_poses = self._odometry(moved, dt)
-        self._sensing.sense(self.true_poses, self.sim_time)
+        self._sensing.sense(self.true_poses, self.sim_time, body_cells)
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
 
