@@ -62,20 +62,33 @@ class NumbaRayCaster:
         xy, ang, rmax, own = ray_arguments(origins_xy, angles, max_ranges, owners)
         n = xy.shape[0]
         cosa, sina = beam_cos_sin(ang)
+        ranges = np.empty(n)
+        every = np.arange(n)
+        cell, hit_robot = self.cast_into(np.ascontiguousarray(xy), every, cosa, sina, rmax, own, robots, every, ranges)
+        return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
+
+    def cast_into(
+        self, origins: np.ndarray, origin_of: np.ndarray, cosa: np.ndarray, sina: np.ndarray, rmax: np.ndarray,
+        owners: np.ndarray, robots: RobotLayer | None, out_at: np.ndarray, out: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`cast` as the simulation calls it, with no copies: ray i starts at ``origins[origin_of[i]]``
+        (every beam of a ranger from one point), its cos and sin given (:func:`beam_cos_sin`), and its range
+        is written to ``out[out_at[i]]``. Returns (hit cell, hit robot) per ray. Arrays: int64 indices,
+        float64 values, C-contiguous."""
+        n = owners.size
         layer = (self._no_robots if robots is None else
                  (robots.regions, robots.ids, robots.rows, robots.cols))
         flags = (robots is not None, robots is not None and robots.active)
-        ranges = np.empty(n)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
-        args = (self._world, layer, flags, self._place, np.ascontiguousarray(xy), cosa, sina,
-                rmax, 1.0 / self.resolution, own, ranges, cell, hit_robot)
+        args = (self._world, layer, flags, self._place, origins, origin_of, cosa, sina, rmax, 1.0 / self.resolution,
+                owners, out_at, out, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
             traversal.cast_parallel(*args)
         else:
             traversal.cast_serial(*args)
-        return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
+        return cell, hit_robot
 
 
 def bit_rows_and_columns(layer: TileLayer) -> tuple[np.ndarray, np.ndarray]:

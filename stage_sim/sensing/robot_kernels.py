@@ -12,27 +12,26 @@ _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
 @numba.njit(**_JIT)
-def number_robot_regions(regions, old, rows, cols, ids, visible, place, width, marked_value):
-    """Clear the regions marked last time (``old``), mark the regions of the cells (rows, cols) on the grid
-    with ``marked_value``, and number the regions of the visible ones 0, 1, … in the order met.
+def number_robot_regions(regions, old, cells, ids, visible, place, width, marked_value):
+    """Clear the regions marked last time (``old``), mark the regions of the flat grid cells (−1: off the
+    grid) with ``marked_value``, and number the regions of the visible ones 0, 1, … in the order met.
 
     Returns (regions marked now, per cell its tile or -1, per cell its row · TILE + col in the tile, tiles)."""
     col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
-    height = place[4]
     flat_regions = regions.ravel()
     rw = regions.shape[1]
     for f in old:
         flat_regions[f] = -1
-    n = rows.size
+    n = cells.size
     marked = np.empty(n, dtype=np.int64)
     tile = np.full(n, -1, dtype=np.int32)
     local = np.zeros(n, dtype=np.int32)
     m = 0
     count = 0
     for i in range(n):
-        r, c = rows[i], cols[i]
-        if r < 0 or r >= height or c < 0 or c >= width:
+        if cells[i] < 0:
             continue
+        r, c = cells[i] // width, cells[i] % width
         wy, wx = r + row0, c + col0
         region = ((wy >> TILE_BITS) - rrow0) * rw + (wx >> TILE_BITS) - rcol0
         if flat_regions[region] == -1:

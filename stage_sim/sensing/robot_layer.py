@@ -68,7 +68,7 @@ class RobotLayer:
         """``compiled``: update with the numba kernels (:mod:`stage_sim.sensing.robot_kernels`), same result."""
         self.grid = grid
         self.compiled = compiled
-        self._place = np.append(grid.place, grid.shape[0])
+        self._place = grid.place
         self.shape = grid.shape
         #: (R, C) int32 per region: its robot tile, :data:`MARKED`, or -1 (no robot cell there)
         self.regions = np.full(grid.slots.shape, -1, dtype=np.int32)
@@ -89,7 +89,7 @@ class RobotLayer:
     ) -> None:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
         if self.compiled:
-            self._update_compiled(cell_rows, cell_cols, robot_ids, visible)
+            self.update_flat(self._flat(cell_rows, cell_cols), robot_ids, visible)
             return
         self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
@@ -114,18 +114,36 @@ class RobotLayer:
         self.block_squares = tile_square_fields(self.blocks[:count] != -1)
         self.active = rows.size > 0
 
-    def _update_compiled(self, cell_rows, cell_cols, robot_ids, visible) -> None:
+    def update_flat(self, cells: np.ndarray, robot_ids: np.ndarray, visible: np.ndarray | None = None) -> None:
+        """:meth:`update` with flat grid cells (−1: off the grid), as the simulation places bodies."""
+        if not self.compiled:
+            self.update(*self._rows_cols(cells), robot_ids, visible)
+            return
         from stage_sim.sensing import robot_kernels
 
-        rows = np.asarray(cell_rows, dtype=np.int64).ravel()
         ids = np.asarray(robot_ids, dtype=np.int64).ravel()
         seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
         self._marked, tile, local, count = robot_kernels.number_robot_regions(
-            self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(), ids, seen,
-            self._place, self.shape[1], MARKED)
+            self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
+            self.shape[1], MARKED)
         self._reserve(count)
         self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, tile, local,
                                                       ids.astype(np.int32), count, SEVERAL_ROBOTS)
+
+    def _flat(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> np.ndarray:
+        """Flat grid cells of (row, col) pairs, −1 for those off the grid."""
+        rows = np.asarray(cell_rows, dtype=np.int64).ravel()
+        cols = np.asarray(cell_cols, dtype=np.int64).ravel()
+        on = (rows >= 0) & (rows < self.shape[0]) & (cols >= 0) & (cols < self.shape[1])
+        return np.where(on, rows * self.shape[1] + cols, -1)
+
+    def _rows_cols(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of flat grid cells, (−1, −1) for −1."""
+        cells = np.asarray(cells, dtype=np.int64).ravel()
+        rows, cols = np.divmod(cells, self.shape[1])
+        off = cells < 0
+        rows[off] = cols[off] = -1
+        return rows, cols
 
     def _reserve(self, count: int) -> None:
         """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
@@ -140,13 +158,8 @@ class RobotLayer:
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
-        if self.compiled:  # the compiled numbering, with no robot seen: marks only
-            from stage_sim.sensing import robot_kernels
-
-            rows = np.asarray(cell_rows, dtype=np.int64).ravel()
-            self._marked = robot_kernels.number_robot_regions(
-                self.regions, self._marked, rows, np.asarray(cell_cols, dtype=np.int64).ravel(),
-                np.zeros(rows.size, dtype=np.int64), np.zeros(1, dtype=bool), self._place, self.shape[1], MARKED)[0]
+        if self.compiled:
+            self.mark_flat(self._flat(cell_rows, cell_cols))
             return
         flat_regions = self.regions.ravel()
         flat_regions[self._marked] = -1
@@ -155,6 +168,18 @@ class RobotLayer:
         rr, rc, _, _ = self.grid.locate(rows * self.shape[1] + cols)
         self._marked = rr * self.regions.shape[1] + rc
         flat_regions[self._marked] = MARKED
+
+    def mark_flat(self, cells: np.ndarray) -> None:
+        """:meth:`mark_regions` with flat grid cells (−1: off the grid)."""
+        if not self.compiled:
+            self.mark_regions(*self._rows_cols(cells))
+            return
+        from stage_sim.sensing import robot_kernels  # the compiled numbering, with no robot seen: marks only
+
+        cells = np.asarray(cells, dtype=np.int64).ravel()
+        self._marked = robot_kernels.number_robot_regions(
+            self.regions, self._marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=bool),
+            self._place, self.shape[1], MARKED)[0]
 
     def look(self, tile, cy, cx, sx, sy, q, owner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """For walks standing in cell (cy, cx) of robot tile ``tile`` (≥ 0): (robot hit or -1, free cells ahead

@@ -55,9 +55,10 @@ def _window(mask, first, length, step):
 
 
 @numba.njit(**_JIT)
-def _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, a, b):
-    """Rays a..b-1: range in metres (exactly ``rmax`` on a miss) into ``out``, flat cell hit (or -1) into
-    ``cell``, robot hit (or -1) into ``rid``."""
+def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
+                rid, a, b):
+    """Rays a..b-1, ray i from point ``origins[origin_of[i]]``: range in metres (exactly ``rmax`` on a miss)
+    into ``out[out_at[i]]``, flat cell hit (or -1) into ``cell[i]``, robot hit (or -1) into ``rid[i]``."""
     static_rows, static_cols, tile_of_slot, slots = world
     robot_regions, robot_ids, robot_rows, robot_cols = robots
     use_regions, use_robots = flags[0], flags[1]
@@ -66,7 +67,7 @@ def _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, o
     for i in range(a, b):
         cos_i, sin_i = cosa[i], sina[i]
         reach = ppm * rmax[i]  # the arithmetic of stage_walk.WalkRays, operation for operation
-        startx, starty = xy[i, 0] * ppm, xy[i, 1] * ppm
+        startx, starty = origins[origin_of[i], 0] * ppm, origins[origin_of[i], 1] * ppm
         tana = sin_i / cos_i
         dx, dy = reach * cos_i, reach * sin_i
         own = owner[i]
@@ -221,25 +222,30 @@ def _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, o
                 dist_y = left_y if takex else yjumpdist
                 dist_x = xjumpdist if takex else left_x
         cell[i], rid[i] = hit_cell, hit_robot
-        out[i] = hit_range if hit_cell >= 0 else rmax[i]
+        out[out_at[i]] = hit_range if hit_cell >= 0 else rmax[i]
 
 
 @numba.njit(**_JIT)
-def cast_serial(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid):
-    """Every ray in order, on the calling thread: ranges in metres (exactly ``rmax`` on a miss) into ``out``.
+def cast_serial(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
+                rid):
+    """Every ray in order, on the calling thread: ranges in metres (exactly ``rmax`` on a miss) into
+    ``out[out_at[i]]``, the cell and robot hit into ``cell[i]`` and ``rid[i]``.
 
     ``world``: (static row masks, static column masks, tile of each slot, slot of each region); ``robots``:
     (robot tile of each region, robot id per cell, robot row masks, robot column masks) of a
     :class:`~stage_sim.sensing.robot_layer.RobotLayer`; ``flags``: (use its regions, use its cells);
+    ``origins``: (K, 2) points rays start from, ray i from ``origin_of[i]`` (a ranger's beams share one);
     ``cosa``, ``sina``: of Stage's beam angles (:func:`~stage_sim.sensing.stage_walk.beam_cos_sin`);
     ``place``: col0, row0, rcol0, rrow0 of the :class:`~stage_sim.maps.tiles.TileGrid` and its width."""
-    _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, 0, owner.size)
+    _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
+                rid, 0, owner.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid):
+def cast_parallel(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
+                  rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(world, robots, flags, place, xy, cosa, sina, rmax, ppm, owner, out, cell, rid, k * _CHUNK,
-                    min(n, (k + 1) * _CHUNK))
+        _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out,
+                    cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))

@@ -61,7 +61,7 @@ def owner_clashes(cells, owner, counted, keys, robot, used, conflict):
         if cell < 0 or not counted[i] or (cell == last_cell and owner[i] == last_owner):
             continue
         last_cell, last_owner = cell, owner[i]
-        slot = ((cell * 2654435761) >> 7) & mask
+        slot = (cell ^ (cell >> 16)) & mask  # neighbouring cells in neighbouring slots: few cache misses
         while keys[slot] != -1 and keys[slot] != cell:
             slot = (slot + 1) & mask
         if keys[slot] == -1:

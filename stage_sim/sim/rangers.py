@@ -12,7 +12,8 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from importlib import import_module
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -22,6 +23,7 @@ from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
+from stage_sim.sensing.stage_walk import beam_cos_sin
 from stage_sim.sim.collision import Bodies, GridFrame, place
 from stage_sim.sim.robots import RobotSpec
 
@@ -52,6 +54,9 @@ class _HeightGroup:
     intensity: CellValues
     robot_visible: np.ndarray
     robot_return: np.ndarray
+    trig: list = field(default_factory=list)
+    """The beam angles of the last cast of every ray of the group and their cos and sin (compiled path):
+    a robot that did not turn (a stalled one) keeps them, so they are not computed again."""
 
 
 class RangerSensing:
@@ -88,6 +93,10 @@ class RangerSensing:
         ray_height = np.concatenate(heights) if heights else np.zeros(0)
         self._groups = self._height_groups(robots, static, ray_height, kernels, threads)
         self._slices = self._ranger_slices()
+        self._scan_slots = [(robot_index, ranger.index, part)
+                            for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
+        # the compiled path looks up intensities in one pass (numba is imported only when it runs)
+        self._returns = import_module("stage_sim.sim.ranger_kernels") if kernels == "numba" else None
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
@@ -134,13 +143,13 @@ class RangerSensing:
                 self._cast(group, chosen, poses, origins, jitter, robot_cells, ranges, intensity)
         noisy = self._apply_noise(ranges, due[self._ranger_of_ray] if ray_due is None else ray_due) \
             if self._noisy else ranges
-        for k in np.flatnonzero(due):
-            robot_index, ranger = self._rangers[k]
-            part = self._slices[k]
-            scan = Scan(noisy[part].astype(np.float32), intensity[part], time)
+        published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
+        for k in (range(len(due)) if all_due else np.flatnonzero(due)):
+            robot_index, ranger_index, part = self._scan_slots[k]
+            scan = Scan(published[part], intensity[part], time)
             robot_scans = self.latest[robot_index]
-            if ranger.index < len(robot_scans):
-                robot_scans[ranger.index] = scan
+            if ranger_index < len(robot_scans):
+                robot_scans[ranger_index] = scan
             else:
                 robot_scans.append(scan)
 
@@ -159,15 +168,22 @@ class RangerSensing:
             angles = angles + jitter[rays]
         layer = None
         if robot_cells is not None:
-            width = self._grid.shape[1]
             if self._bodies.count > 1:
-                group.robots.update(robot_cells // width, robot_cells % width, self._bodies.owner, group.robot_visible)
+                group.robots.update_flat(robot_cells, self._bodies.owner, group.robot_visible)
             else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
-                group.robots.mark_regions(robot_cells // width, robot_cells % width)
+                group.robots.mark_flat(robot_cells)
             layer = group.robots
+        if self._returns is not None:
+            cosa, sina = self._trig(group, angles, chosen is None)
+            cell, hit_robot = group.caster.cast_into(origins, ranger, cosa, sina, max_range, owner, layer, rays, ranges)
+            several = float(group.robot_return.max(initial=0.0))
+            static = group.intensity
+            self._returns.hit_intensity(cell, hit_robot, static.cells, static.values, group.robot_return,
+                                        self._bodies.count > 1, SEVERAL_ROBOTS, several, rays, intensity)
+            return
         result = group.caster.cast(origins[ranger], angles, max_range, owners=owner, robots=layer)
         ranges[rays] = result.ranges
-        static_hit = result.hit_cell >= 0
+        static_hit = (result.hit_cell >= 0) & (result.hit_robot == -1)
         hits = np.zeros(len(rays), dtype=np.float32)
         hits[static_hit] = group.intensity.at(result.hit_cell[static_hit])
         if self._bodies.count > 1:  # a lone robot never sees itself
@@ -176,6 +192,24 @@ class RangerSensing:
             # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
             hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
         intensity[rays] = hits
+
+    @staticmethod
+    def _trig(group: _HeightGroup, angles: np.ndarray, every_ray: bool) -> tuple[np.ndarray, np.ndarray]:
+        """cos and sin of the beam angles (:func:`beam_cos_sin`), computed again only where an angle changed
+        since the group's last cast of all its rays."""
+        if not every_ray:
+            return beam_cos_sin(angles)
+        if not group.trig or group.trig[0].shape != angles.shape:
+            group.trig[:] = (angles, *beam_cos_sin(angles))
+            return group.trig[1], group.trig[2]
+        previous, cosa, sina = group.trig
+        changed = np.flatnonzero(angles != previous)
+        if changed.size == angles.size:
+            cosa, sina = beam_cos_sin(angles)
+        elif changed.size:
+            cosa[changed], sina[changed] = beam_cos_sin(angles[changed])
+        group.trig[:] = (angles, cosa, sina)
+        return cosa, sina
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
         """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle
