@@ -17,9 +17,11 @@ the step count and the steps along each axis after a run are those of the step-b
 walk stops, and what it reports, are too.
 
 Between regions, the jumps over empty regions follow Stage's floating-point crossings one by one (each
-crossing decides where the walk enters the next region holding a block). The loop over rays holds the
-whole walk: a per-ray function taking the arrays had numba count references to each of them, 14 atomic
-operations per ray (about 60 ns, more than a short ray's walk).
+crossing decides where the walk enters the next region holding a block). The step count they update,
+Stage's ``n = (int)(n - dist)``, is kept in a float between regions (``trunc``: the same integer, without a
+round trip through an integer register per jump, which made it the longest chain of a jump). The loop over
+rays holds the whole walk: a per-ray function taking the arrays had numba count references to each of
+them, 14 atomic operations per ray (about 60 ns, more than a short ray's walk).
 """
 
 from __future__ import annotations
@@ -93,7 +95,8 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
         basex, basey = startx, starty  # globx = basex + kx: whole steps since the start or the last jump
         kx = ky = 0
         calculate_crossings = True
-        while n > 0:
+        steps_left = float(n)  # the step count as Stage's jumps update it: (int)(n - dist), kept in a float
+        while steps_left > 0:
             globx, globy = basex + kx, basey + ky
             ix, iy = int(globx), int(globy)  # C's truncation, as Stage's GETREG gets it
             rr, rc = (iy >> REGION_BITS) - rrow0, (ix >> REGION_BITS) - rcol0
@@ -109,6 +112,7 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                 cx0, cy0 = ix & (REGION - 1), iy & (REGION - 1)
                 cx, cy = cx0, cy0
                 found = False
+                n = np.int64(steps_left)
                 if xmajor:
                     r = (by - 1 - exy) // by if by > 0 else _ENDLESS  # x-steps before the next y-step
                     while True:
@@ -185,10 +189,11 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                             break
                 kx += cx - cx0
                 ky += cy - cy0
+                steps_left = float(n)
                 if found:
                     hit_range = _distance(ax, ay, basex + kx, basey + ky, startx, starty, cos_i, sin_i, ppm)
                     hit_cell = (iy + cy - cy0 - row0) * width + ix + cx - cx0 - col0
-                    n = 0
+                    steps_left = 0.0
             else:
                 if calculate_crossings:
                     calculate_crossings = False
@@ -211,7 +216,7 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                 takex = dist_x < dist_y
                 basex = xcrossx if takex else ycrossx
                 basey = xcrossy if takex else ycrossy
-                n = np.int64(n - (dist_x if takex else dist_y))
+                steps_left = np.trunc(steps_left - (dist_x if takex else dist_y))
                 next_xx, next_xy = xcrossx + xjumpx, xcrossy + xjumpy
                 next_yx, next_yy = ycrossx + yjumpx, ycrossy + yjumpy
                 left_y, left_x = dist_y - dist_x, dist_x - dist_y
