@@ -6,7 +6,9 @@ the static collision layer (in tiles, :class:`~stage_sim.maps.tiles.TileLayer`) 
 the cells they share (sorted (cell, robot) pairs, or a hash table of the robots' cells in the compiled
 path: memory in proportion to the robots' cells, 16-32 B each, never to the world's area). The cells of
 every body at the accepted poses are kept up to date through the rounds of refusals (only the refused
-robots' cells change) and handed to the lasers, which see the robots through the same cells. As in Stage,
+robots' cells change) and handed to the lasers, which see the robots through the same cells. A clash
+that a round leaves must involve a robot that round moved back (the others share the cells they had), so
+the next round looks only at robots within touching distance of those. As in Stage,
 a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
 robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
 intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
@@ -25,6 +27,9 @@ from stage_sim.sim.kinematics import integrate
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
 # rounds settle every realistic case, after which all robots still in conflict are refused together.
 MAX_CONFLICT_ROUNDS = 4
+# Robots refused in a round times colliding robots up to which the next round's clash test is narrowed to
+# the robots near the refused ones by a distance test (beyond, the test takes every colliding robot).
+NARROWING_PAIRS = 200_000
 
 
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
@@ -99,7 +104,7 @@ class CollisionChecker:
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-        self._point_collides = collides[bodies.owner] if bodies.count else np.zeros(0, dtype=bool)
+        self._colliding = np.flatnonzero(collides)
         # The compiled clash test's hash table: 24 B per slot, over twice the colliding robots' points.
         points = int(counts[collides].sum()) if len(collides) else 0
         size = 1 << max(1, (2 * points - 1).bit_length())
@@ -128,14 +133,17 @@ class CollisionChecker:
         cells = self.bodies.point_cells(final, self.grid)
         if not self._robots_can_clash:
             return final, refused, cells
+        among = self._colliding
         for _ in range(MAX_CONFLICT_ROUNDS):
-            conflict = self._clashes(cells) & moving & ~refused
+            conflict = self._clashes(cells, among) & moving & ~refused
             if not conflict.any():
                 return final, refused, cells
             refused |= conflict
             final = np.where(refused[:, None], poses, candidates)
-            self._replace_cells(cells, final, np.flatnonzero(conflict))
-        last = self._clashes(cells) & moving & ~refused
+            moved_back = np.flatnonzero(conflict)
+            self._replace_cells(cells, final, moved_back)
+            among = self._near(moved_back, final)
+        last = self._clashes(cells, among) & moving & ~refused
         refused |= last
         final = np.where(refused[:, None], poses, candidates)
         self._replace_cells(cells, final, np.flatnonzero(last))
@@ -149,7 +157,7 @@ class CollisionChecker:
             touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
         if not self._robots_can_clash:
             return touching
-        return touching | self._clashes(self.bodies.point_cells(poses, self.grid))
+        return touching | self._clashes(self.bodies.point_cells(poses, self.grid), self._colliding)
 
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
@@ -232,16 +240,34 @@ class CollisionChecker:
         point_index, entry = self._points_of(robots)
         cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
 
-    def _clashes(self, cells: np.ndarray) -> np.ndarray:
-        """Colliding robots whose body points (``cells``, per body point) share a cell with another colliding
-        robot's."""
+    def _near(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """The colliding robots whose bodies at ``poses`` could share a cell with one of ``robots``' (centres no
+        farther apart than their radii and two cells), ``robots`` included; all of them for many ``robots``."""
+        if robots.size * self._colliding.size > NARROWING_PAIRS:
+            return self._colliding
+        if self.grid.kernels == "numba":
+            from stage_sim.sim.collision_kernels import near_robots
+
+            near = np.zeros(self._colliding.size, dtype=bool)
+            near_robots(self._colliding, robots, poses, self.bodies.radius, 2 * self.grid.resolution, near)
+            return self._colliding[near]
+        others = self._colliding
+        gap = poses[others, None, :2] - poses[None, robots, :2]
+        reach = self.bodies.radius[others, None] + self.bodies.radius[None, robots] + 2 * self.grid.resolution
+        return others[np.any(np.hypot(gap[..., 0], gap[..., 1]) <= reach, axis=1)]
+
+    def _clashes(self, cells: np.ndarray, among: np.ndarray) -> np.ndarray:
+        """Robots of ``among`` (colliding robots) whose body points (``cells``, per body point) share a cell
+        with another robot of ``among``."""
         conflict = np.zeros(self.bodies.count, dtype=bool)
         if self.grid.kernels == "numba":
             from stage_sim.sim.collision_kernels import owner_clashes
 
-            owner_clashes(cells, self.bodies.owner, self._point_collides, *self._table, conflict)
+            owner_clashes(cells, among, self._point_start, self._point_count, *self._table, conflict)
             return conflict
-        keep = (cells >= 0) & self._point_collides
+        taking = np.zeros(self.bodies.count, dtype=bool)
+        taking[among] = True
+        keep = (cells >= 0) & taking[self.bodies.owner]
         robots = np.int64(self.bodies.count)
         pairs = unique_sorted(cells[keep] * robots + self.bodies.owner[keep])  # each (cell, robot) once, by cell
         shared = pairs[1:] // robots == pairs[:-1] // robots

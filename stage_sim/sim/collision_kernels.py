@@ -47,33 +47,49 @@ def robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, o
 
 
 @numba.njit(**_JIT)
-def owner_clashes(cells, owner, counted, keys, robot, used, conflict):
-    """Mark robots sharing a cell (-1: off the grid, ignored; only points with ``counted`` set take part) in
-    an open-addressing table of the cells seen (``keys``, all -1, a power of two over twice the points;
-    ``robot`` the first robot seen in each; ``used`` room for a slot per point): a later point of another
-    robot in a cell flags both. The table is left empty again. The numpy reference sorts (cell, robot) pairs
-    instead."""
+def owner_clashes(cells, robots, first, count, keys, robot, used, conflict):
+    """Mark the robots of ``robots`` sharing a cell (robot r's points are ``first[r]`` on, ``count[r]`` of
+    them; cell -1: off the grid, ignored) in an open-addressing table of the cells seen (``keys``, all -1, a
+    power of two over twice the points; ``robot`` the first robot seen in each; ``used`` room for a slot per
+    point): a later point of another robot in a cell flags both. The table is left empty again. The numpy
+    reference sorts (cell, robot) pairs instead."""
     mask = keys.size - 1
     m = 0
-    last_cell = last_owner = -1
-    for i in range(cells.size):
-        cell = cells[i]
-        if cell < 0 or not counted[i] or (cell == last_cell and owner[i] == last_owner):
-            continue
-        last_cell, last_owner = cell, owner[i]
-        slot = (cell ^ (cell >> 16)) & mask  # neighbouring cells in neighbouring slots: few cache misses
-        while keys[slot] != -1 and keys[slot] != cell:
-            slot = (slot + 1) & mask
-        if keys[slot] == -1:
-            keys[slot] = cell
-            robot[slot] = owner[i]
-            used[m] = slot
-            m += 1
-        elif robot[slot] != owner[i]:
-            conflict[robot[slot]] = True
-            conflict[owner[i]] = True
+    for k in range(robots.size):
+        owner = robots[k]
+        last_cell = -1
+        for i in range(first[owner], first[owner] + count[owner]):
+            cell = cells[i]
+            if cell < 0 or cell == last_cell:
+                continue
+            last_cell = cell
+            slot = (cell ^ (cell >> 16)) & mask  # neighbouring cells in neighbouring slots: few cache misses
+            while keys[slot] != -1 and keys[slot] != cell:
+                slot = (slot + 1) & mask
+            if keys[slot] == -1:
+                keys[slot] = cell
+                robot[slot] = owner
+                used[m] = slot
+                m += 1
+            elif robot[slot] != owner:
+                conflict[robot[slot]] = True
+                conflict[owner] = True
     for j in range(m):
         keys[used[j]] = -1
+
+
+@numba.njit(**_JIT)
+def near_robots(others, robots, poses, radius, margin, near):
+    """``near[k]``: whether robot ``others[k]`` lies within touching distance of one of ``robots`` (centres
+    no farther apart than the two radii and ``margin``), as the numpy reference's distance matrix says."""
+    for k in range(others.size):
+        j = others[k]
+        for i in robots:
+            dx = poses[j, 0] - poses[i, 0]
+            dy = poses[j, 1] - poses[i, 1]
+            if math.hypot(dx, dy) <= radius[j] + radius[i] + margin:
+                near[k] = True
+                break
 
 
 @numba.njit(**_JIT)
