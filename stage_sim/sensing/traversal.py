@@ -11,8 +11,8 @@ that stop rays (static cells at this height, :mod:`stage_sim.maps.tiles`; robot 
 integer line, which moves along its major axis in runs: an x-major line takes ``r`` x-steps, then one
 y-step, where the first run follows from the error term and every later one is ``q`` or ``q + 1`` (``q,
 rem = divmod(2·ax, 2·ay)``: ``q + 1`` when the error before the y-step is below ``rem``). So the walk takes a
-whole run of cells in one test of a row mask (a column mask for y-major lines), and looks at cells one by
-one only in a run that holds a set bit (a hit, or the ray's own robot, which it passes). The error term,
+whole run of cells in one test of a row mask (a column mask for y-major lines); in a run that holds set
+bits it looks at those cells only, in the walk's order (a hit, or the ray's own robot, which it passes). The error term,
 the step count and the steps along each axis after a run are those of the step-by-step walk, so where the
 walk stops, and what it reports, are too.
 
@@ -30,6 +30,7 @@ import math
 
 import numba
 import numpy as np
+from numba.cpython.unsafe.numbers import leading_zeros, trailing_zeros
 
 from stage_sim.sensing.stage_walk import REGION, REGION_BITS
 
@@ -54,6 +55,15 @@ def _window(mask, first, length, step):
     """The bits of ``length`` cells of a 32-bit row (column) mask from cell ``first`` on, towards ``step``."""
     low = first if step > 0 else first - length + 1
     return (np.uint64(mask) >> np.uint64(low)) & ((np.uint64(1) << np.uint64(length)) - np.uint64(1))
+
+
+@numba.njit(inline="always", **_JIT)
+def _first(bits, length, step):
+    """(steps from the window's first cell to its first set cell along the walk, ``bits`` without it)."""
+    if step > 0:
+        return np.int64(trailing_zeros(bits)), bits & (bits - np.uint64(1))
+    high = np.int64(63 - leading_zeros(bits))
+    return length - 1 - high, bits ^ (np.uint64(1) << np.uint64(high))
 
 
 @numba.njit(**_JIT)
@@ -122,19 +132,20 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                             mask = static_rows[stile, cy]
                         if rt >= 0:
                             mask |= robot_rows[rt, cy]
-                        if _window(mask, cx, length, sx) != 0:
-                            for c in range(length):
-                                x = cx + c * sx
-                                if rt >= 0 and (robot_rows[rt, cy] >> x) & 1 and robot_ids[rt, cy, x] != own:
-                                    hit_robot, found = robot_ids[rt, cy, x], True
-                                elif stile >= 0 and (static_rows[stile, cy] >> x) & 1:
-                                    found = True
-                                if found:
-                                    cx = x
-                                    exy += c * by
-                                    break
+                        bits = _window(mask, cx, length, sx)
+                        while bits != 0:  # its set cells in the walk's order: a hit, or the ray's own robot
+                            c, bits = _first(bits, length, sx)
+                            x = cx + c * sx
+                            if rt >= 0 and (robot_rows[rt, cy] >> x) & 1 and robot_ids[rt, cy, x] != own:
+                                hit_robot, found = robot_ids[rt, cy, x], True
+                            elif stile >= 0 and (static_rows[stile, cy] >> x) & 1:
+                                found = True
                             if found:
+                                cx = x
+                                exy += c * by
                                 break
+                        if found:
+                            break
                         if length == r + 1:  # the whole run, then the y-step
                             cx += r * sx
                             error = exy + r * by
@@ -160,19 +171,20 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                             mask = static_cols[stile, cx]
                         if rt >= 0:
                             mask |= robot_cols[rt, cx]
-                        if _window(mask, cy, length, sy) != 0:
-                            for c in range(length):
-                                y = cy + c * sy
-                                if rt >= 0 and (robot_cols[rt, cx] >> y) & 1 and robot_ids[rt, y, cx] != own:
-                                    hit_robot, found = robot_ids[rt, y, cx], True
-                                elif stile >= 0 and (static_cols[stile, cx] >> y) & 1:
-                                    found = True
-                                if found:
-                                    cy = y
-                                    exy -= c * bx
-                                    break
+                        bits = _window(mask, cy, length, sy)
+                        while bits != 0:
+                            c, bits = _first(bits, length, sy)
+                            y = cy + c * sy
+                            if rt >= 0 and (robot_cols[rt, cx] >> y) & 1 and robot_ids[rt, y, cx] != own:
+                                hit_robot, found = robot_ids[rt, y, cx], True
+                            elif stile >= 0 and (static_cols[stile, cx] >> y) & 1:
+                                found = True
                             if found:
+                                cy = y
+                                exy -= c * bx
                                 break
+                        if found:
+                            break
                         if length == r + 1:  # the whole run, then the x-step
                             cy += r * sy
                             error = exy - r * bx
