@@ -18,7 +18,9 @@ from stage_sim.sensing import traversal
 from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sensing.stage_walk import beam_cos_sin, ray_arguments, static_layer
+from stage_sim.sensing.stage_walk import ray_arguments, static_layer
+
+_NONE = np.zeros(0)  # an absent jitter or trigonometry cache
 
 
 class NumbaRayCaster:
@@ -61,28 +63,31 @@ class NumbaRayCaster:
         """Cast N rays; ``owners[i]`` is the robot that ray i belongs to (−1: none)."""
         xy, ang, rmax, own = ray_arguments(origins_xy, angles, max_ranges, owners)
         n = xy.shape[0]
-        cosa, sina = beam_cos_sin(ang)
         ranges = np.empty(n)
         every = np.arange(n)
-        cell, hit_robot = self.cast_into(np.ascontiguousarray(xy), every, cosa, sina, rmax, own, robots, every, ranges)
+        cell, hit_robot = self.cast_into(np.ascontiguousarray(xy), every, np.zeros(n), ang, rmax, own, robots, every,
+                                         ranges)
         return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
 
     def cast_into(
-        self, origins: np.ndarray, origin_of: np.ndarray, cosa: np.ndarray, sina: np.ndarray, rmax: np.ndarray,
+        self, origins: np.ndarray, origin_of: np.ndarray, heading: np.ndarray, local: np.ndarray, rmax: np.ndarray,
         owners: np.ndarray, robots: RobotLayer | None, out_at: np.ndarray, out: np.ndarray,
+        jitter: np.ndarray = _NONE, trig: tuple[np.ndarray, np.ndarray, np.ndarray] = (_NONE, _NONE, _NONE),
     ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`cast` as the simulation calls it, with no copies: ray i starts at ``origins[origin_of[i]]``
-        (every beam of a ranger from one point), its cos and sin given (:func:`beam_cos_sin`), and its range
-        is written to ``out[out_at[i]]``. Returns (hit cell, hit robot) per ray. Arrays: int64 indices,
-        float64 values, C-contiguous."""
+        (every beam of a ranger from one point) at angle ``heading[origin_of[i]] + local[i]`` (plus
+        ``jitter[out_at[i]]`` when given), and its range is written to ``out[out_at[i]]``. ``trig``: the angle,
+        cos and sin of each ``out_at`` slot's last cast (NaN angles at first), which the kernel keeps and
+        reuses for beams whose angle did not change. Returns (hit cell, hit robot) per ray. Arrays: int64
+        indices, float64 values, C-contiguous."""
         n = owners.size
         layer = (self._no_robots if robots is None else
                  (robots.regions, robots.ids, robots.rows, robots.cols))
         flags = (robots is not None, robots is not None and robots.active)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
-        args = (self._world, layer, flags, self._place, origins, origin_of, cosa, sina, rmax, 1.0 / self.resolution,
-                owners, out_at, out, cell, hit_robot)
+        args = (self._world, layer, flags, self._place, origins, origin_of, heading, local, jitter, trig, rmax,
+                1.0 / self.resolution, owners, out_at, out, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
             traversal.cast_parallel(*args)

@@ -32,6 +32,7 @@ jump (``base + count``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -115,9 +116,14 @@ def _per_ray(value: np.ndarray | float, n: int, dtype: type) -> np.ndarray:
 
 
 def beam_cos_sin(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """cos and sin of the beam angles, an angle of exactly 0 turned into :data:`ZERO_ANGLE` as Stage does."""
-    angle = np.where(angles == 0.0, ZERO_ANGLE, angles)
-    return np.cos(angle), np.sin(angle)
+    """cos and sin of the beam angles, an angle of exactly 0 turned into :data:`ZERO_ANGLE` as Stage does.
+
+    Computed by the C library's ``cos`` and ``sin`` (Python's ``math``), as Stage computes them and as the
+    compiled walk does (numba calls the same functions), so both casters start every ray alike whatever
+    SIMD routines numpy's ufuncs pick on a machine."""
+    angle = np.where(np.asarray(angles, dtype=np.float64) == 0.0, ZERO_ANGLE, angles).ravel()
+    return (np.fromiter(map(math.cos, angle.tolist()), np.float64, angle.size),
+            np.fromiter(map(math.sin, angle.tolist()), np.float64, angle.size))
 
 
 def finish_ranges(walked: np.ndarray, max_ranges: np.ndarray) -> np.ndarray:

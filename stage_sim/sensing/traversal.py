@@ -32,7 +32,7 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros, trailing_zeros
 
-from stage_sim.sensing.stage_walk import REGION, REGION_BITS
+from stage_sim.sensing.stage_walk import REGION, REGION_BITS, ZERO_ANGLE
 
 #: Run length standing for "no end" (a line along an axis has a single run).
 _ENDLESS = 1 << 40
@@ -67,19 +67,32 @@ def _first(bits, length, step):
 
 
 @numba.njit(**_JIT)
-def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
-                rid, a, b):
-    """Rays a..b-1, ray i from point ``origins[origin_of[i]]``: range in metres (exactly ``rmax`` on a miss)
-    into ``out[out_at[i]]``, flat cell hit (or -1) into ``cell[i]``, robot hit (or -1) into ``rid[i]``."""
+def _cast_range(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm, owner,
+                out_at, out, cell, rid, a, b):
+    """Rays a..b-1, ray i from point ``origins[origin_of[i]]`` at angle ``heading[origin_of[i]] + local[i]``
+    (``+ jitter[out_at[i]]`` if given): range in metres (exactly ``rmax`` on a miss) into ``out[out_at[i]]``,
+    flat cell hit (or -1) into ``cell[i]``, robot hit (or -1) into ``rid[i]``."""
     static_rows, static_cols, tile_of_slot, slots = world
     robot_regions, robot_ids, robot_rows, robot_cols = robots
     use_regions, use_robots = flags[0], flags[1]
     col0, row0, rcol0, rrow0, width = place[0], place[1], place[2], place[3], place[4]
     rh, rw = slots.shape
+    last_angle, last_cos, last_sin = trig
+    jittered, remembered = jitter.size > 0, last_angle.size > 0
     for i in range(a, b):
-        cos_i, sin_i = cosa[i], sina[i]
+        o, at = origin_of[i], out_at[i]
+        angle = heading[o] + local[i]
+        if jittered:
+            angle += jitter[at]
+        if remembered and angle == last_angle[at]:  # a robot that did not turn: its beams' cos and sin
+            cos_i, sin_i = last_cos[at], last_sin[at]
+        else:  # the C library's cos and sin, as Stage's (stage_walk.beam_cos_sin)
+            turned = angle if angle != 0.0 else ZERO_ANGLE
+            cos_i, sin_i = math.cos(turned), math.sin(turned)
+            if remembered:
+                last_angle[at], last_cos[at], last_sin[at] = angle, cos_i, sin_i
         reach = ppm * rmax[i]  # the arithmetic of stage_walk.WalkRays, operation for operation
-        startx, starty = origins[origin_of[i], 0] * ppm, origins[origin_of[i], 1] * ppm
+        startx, starty = origins[o, 0] * ppm, origins[o, 1] * ppm
         tana = sin_i / cos_i
         dx, dy = reach * cos_i, reach * sin_i
         own = owner[i]
@@ -239,30 +252,31 @@ def _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rma
                 dist_y = left_y if takex else yjumpdist
                 dist_x = xjumpdist if takex else left_x
         cell[i], rid[i] = hit_cell, hit_robot
-        out[out_at[i]] = hit_range if hit_cell >= 0 else rmax[i]
+        out[at] = hit_range if hit_cell >= 0 else rmax[i]
 
 
 @numba.njit(**_JIT)
-def cast_serial(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
-                rid):
+def cast_serial(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm, owner,
+                out_at, out, cell, rid):
     """Every ray in order, on the calling thread: ranges in metres (exactly ``rmax`` on a miss) into
     ``out[out_at[i]]``, the cell and robot hit into ``cell[i]`` and ``rid[i]``.
 
     ``world``: (static row masks, static column masks, tile of each slot, slot of each region); ``robots``:
     (robot tile of each region, robot id per cell, robot row masks, robot column masks) of a
     :class:`~stage_sim.sensing.robot_layer.RobotLayer`; ``flags``: (use its regions, use its cells);
-    ``origins``: (K, 2) points rays start from, ray i from ``origin_of[i]`` (a ranger's beams share one);
-    ``cosa``, ``sina``: of Stage's beam angles (:func:`~stage_sim.sensing.stage_walk.beam_cos_sin`);
+    ``origins``: (K, 2) points rays start from, ray i from ``origin_of[i]`` (a ranger's beams share one)
+    at angle ``heading[origin_of[i]] + local[i]`` (+ ``jitter[out_at[i]]`` unless ``jitter`` is empty);
+    ``trig``: (angle, cos, sin) of each ``out_at`` slot's last cast, kept up to date (empty arrays: none);
     ``place``: col0, row0, rcol0, rrow0 of the :class:`~stage_sim.maps.tiles.TileGrid` and its width."""
-    _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
-                rid, 0, owner.size)
+    _cast_range(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm, owner,
+                out_at, out, cell, rid, 0, owner.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def cast_parallel(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out, cell,
-                  rid):
+def cast_parallel(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm, owner,
+                  out_at, out, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
-        _cast_range(world, robots, flags, place, origins, origin_of, cosa, sina, rmax, ppm, owner, out_at, out,
-                    cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
+        _cast_range(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm,
+                    owner, out_at, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))

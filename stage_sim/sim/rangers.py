@@ -12,7 +12,7 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from importlib import import_module
 from typing import TYPE_CHECKING
 
@@ -23,7 +23,6 @@ from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
-from stage_sim.sensing.stage_walk import beam_cos_sin
 from stage_sim.sim.collision import Bodies, GridFrame, place
 from stage_sim.sim.robots import RobotSpec
 
@@ -54,9 +53,6 @@ class _HeightGroup:
     intensity: CellValues
     robot_visible: np.ndarray
     robot_return: np.ndarray
-    trig: list = field(default_factory=list)
-    """The beam angles of the last cast of every ray of the group and their cos and sin (compiled path):
-    a robot that did not turn (a stalled one) keeps them, so they are not computed again."""
 
 
 class RangerSensing:
@@ -97,6 +93,10 @@ class RangerSensing:
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
         # the compiled path looks up intensities in one pass (numba is imported only when it runs)
         self._returns = import_module("stage_sim.sim.ranger_kernels") if kernels == "numba" else None
+        # and keeps every beam's last angle with its cos and sin: a robot that did not turn (a stalled one)
+        # does not compute them again
+        self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
+        self._no_jitter = np.zeros(0)
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
@@ -163,9 +163,6 @@ class RangerSensing:
         if chosen is not None:
             owner, ranger, angle, max_range, rays = (
                 owner[chosen], ranger[chosen], angle[chosen], max_range[chosen], rays[chosen])
-        angles = poses[owner, 2] + angle
-        if jitter is not None:
-            angles = angles + jitter[rays]
         layer = None
         if robot_cells is not None:
             if self._bodies.count > 1:
@@ -174,13 +171,17 @@ class RangerSensing:
                 group.robots.mark_flat(robot_cells)
             layer = group.robots
         if self._returns is not None:
-            cosa, sina = self._trig(group, angles, chosen is None)
-            cell, hit_robot = group.caster.cast_into(origins, ranger, cosa, sina, max_range, owner, layer, rays, ranges)
+            cell, hit_robot = group.caster.cast_into(
+                origins, ranger, poses[self._ranger_owner, 2], angle, max_range, owner, layer, rays, ranges,
+                jitter=self._no_jitter if jitter is None else jitter, trig=self._trig)
             several = float(group.robot_return.max(initial=0.0))
             static = group.intensity
             self._returns.hit_intensity(cell, hit_robot, static.cells, static.values, group.robot_return,
                                         self._bodies.count > 1, SEVERAL_ROBOTS, several, rays, intensity)
             return
+        angles = poses[owner, 2] + angle
+        if jitter is not None:
+            angles = angles + jitter[rays]
         result = group.caster.cast(origins[ranger], angles, max_range, owners=owner, robots=layer)
         ranges[rays] = result.ranges
         static_hit = (result.hit_cell >= 0) & (result.hit_robot == -1)
@@ -192,24 +193,6 @@ class RangerSensing:
             # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
             hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
         intensity[rays] = hits
-
-    @staticmethod
-    def _trig(group: _HeightGroup, angles: np.ndarray, every_ray: bool) -> tuple[np.ndarray, np.ndarray]:
-        """cos and sin of the beam angles (:func:`beam_cos_sin`), computed again only where an angle changed
-        since the group's last cast of all its rays."""
-        if not every_ray:
-            return beam_cos_sin(angles)
-        if not group.trig or group.trig[0].shape != angles.shape:
-            group.trig[:] = (angles, *beam_cos_sin(angles))
-            return group.trig[1], group.trig[2]
-        previous, cosa, sina = group.trig
-        changed = np.flatnonzero(angles != previous)
-        if changed.size == angles.size:
-            cosa, sina = beam_cos_sin(angles)
-        elif changed.size:
-            cosa[changed], sina[changed] = beam_cos_sin(angles[changed])
-        group.trig[:] = (angles, cosa, sina)
-        return cosa, sina
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
         """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle
