@@ -1,4 +1,4 @@
-"""Free-space certificates for both ray casters: the largest free square ahead of a cell, within its tile.
+"""Free-space certificates for the numpy ray caster: the largest free square ahead of a cell, within its tile.
 
 For each cell ``c`` of a tile and each of the four diagonal quadrants ``q = (sx < 0) + 2·(sy < 0)``, the
 side ``k`` of the largest free square that has ``c`` as its corner and extends towards ``(sx, sy)``

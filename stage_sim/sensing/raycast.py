@@ -46,7 +46,6 @@ from stage_sim.sensing.stage_walk import (
     REGION_BITS,
     WalkRays,
     finish_ranges,
-    free_squares,
     ray_arguments,
     static_layer,
 )
@@ -99,7 +98,7 @@ class GridRayCaster:
         self.height, self.width = layer.grid.shape
         self._grid = layer.grid
         self._tile_of_slot = layer.tile_of_slot
-        self._squares = free_squares(layer, tile_square_fields)
+        self._squares = free_squares(layer)
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
@@ -259,6 +258,15 @@ class GridRayCaster:
         si[_R, rows] += j * sy
         si[_E, rows] += i * by - j * bx
         si[_N, rows] -= i + j
+
+
+def free_squares(layer: TileLayer) -> np.ndarray:
+    """The layer's free squares (:func:`~stage_sim.sensing.distance_field.tile_square_fields`, 4 KB a tile),
+    computed the first time only and kept with the layer (casters of heights that see the same cells share
+    them)."""
+    if "squares" not in layer.derived:
+        layer.derived["squares"] = tile_square_fields(layer.occupied)
+    return layer.derived["squares"]
 
 
 def _start_state(rays: WalkRays, own: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

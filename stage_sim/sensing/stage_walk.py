@@ -33,7 +33,6 @@ jump (``base + count``).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,18 +42,11 @@ from stage_sim.maps.tiles import TILE, TILE_BITS, TileGrid, TileLayer
 #: Cells per region side (Stage's ``RBITS = 5``): the world's tiles are its regions.
 REGION_BITS = TILE_BITS
 REGION = TILE
-#: Robot occupancy blocks inside a region, 2**BLOCK cells a side: the walk crosses robot-free blocks at once.
+#: Robot occupancy blocks inside a region, 2**BLOCK cells a side: the numpy walk crosses robot-free blocks
+#: at once.
 BLOCK = 3
 #: Stage turns a beam at exactly angle 0 into this angle (a zero sine would divide by zero).
 ZERO_ANGLE = 1e-12
-
-
-def free_squares(layer: TileLayer, compute: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
-    """The layer's free squares (:func:`~stage_sim.sensing.distance_field.tile_square_fields`), computed by
-    ``compute`` the first time only: the numpy and the compiled caster of one layer share them (4 KB a tile)."""
-    if "squares" not in layer.derived:
-        layer.derived["squares"] = compute(layer.occupied)
-    return layer.derived["squares"]
 
 
 def static_layer(
