@@ -9,12 +9,12 @@ import re
 import pytest
 
 from tests.corpus.children import CPU_BUDGET_S, LOCATED_MESSAGE, console_script, run_limited
-from tests.corpus.worlds_list import FAILS_TO_LOAD, STAGEROS_TOO_SLOW, World, params
+from tests.corpus.worlds_list import FAILS_TO_LOAD, World, params
 
 READY = re.compile(r"\[stageros\]: \S+: \d+ robot\(s\), interval_sim")
 
 
-@pytest.mark.parametrize("world", params(waiting=STAGEROS_TOO_SLOW))
+@pytest.mark.parametrize("world", params())
 def test_stageros_comes_up_and_stops_on_ctrl_c(world: World) -> None:
     run = run_limited([console_script("stageros"), "-g", str(world.path)], ready=READY)
     assert run.returncode is not None, f"stageros still running after its wall timeout: {run.stderr[-500:]}"

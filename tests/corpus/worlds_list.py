@@ -17,13 +17,6 @@ REPO = Path(__file__).resolve().parents[2]
 CORPUS = Path(os.environ.get("STAGE_SIM_CORPUS") or REPO.parent / "shared" / "corpus")
 OWN_WORLDS = Path(__file__).resolve().parent / "worlds"
 
-STAGEROS_TOO_SLOW = {
-    "stage-worlds/benchmark/hospital.world": (
-        "stageros needs 13-15 s of CPU for 1000 robots (issue #14): world and simulation ~4 s, creating the "
-        "5000 DDS endpoints of 1000 robots ~5 s and deleting them ~3 s in rclpy/Fast DDS"),
-}
-"""Worlds that load, but where stageros takes over 10 s of CPU to come up (strict xfail: remove them then)."""
-
 FAILS_TO_LOAD = {
     "stage-worlds/wifi.world": "unknown entity type 'map'",
     "stage-worlds/wifi/commando.world": 'cannot open include file "pioneer.inc"',
@@ -51,17 +44,9 @@ def worlds() -> list[World]:
     return found
 
 
-def params(loading_only: bool = False, waiting: dict[str, str] | None = None) -> list:
-    """pytest params, the worlds in ``waiting`` marked strict xfail with the reason; ``loading_only`` drops
-    the worlds that are expected to fail to load."""
-    waits = waiting or {}
-    chosen = []
-    for world in worlds():
-        if loading_only and world.id in FAILS_TO_LOAD:
-            continue
-        marks = [pytest.mark.xfail(strict=True, reason=waits[world.id])] if world.id in waits else []
-        chosen.append(pytest.param(world, id=world.id, marks=marks))
-    return chosen
+def params(loading_only: bool = False) -> list:
+    """pytest params of the worlds; ``loading_only`` drops the worlds that are expected to fail to load."""
+    return [pytest.param(world, id=world.id) for world in worlds() if not (loading_only and world.id in FAILS_TO_LOAD)]
 
 
 def require_corpus() -> None:
