@@ -22,6 +22,7 @@ import numpy as np
 
 from stage_sim.maps.polygon_raster import point_cells
 from stage_sim.maps.tiles import TileLayer, unique_sorted
+from stage_sim.sensing.kernels import set_threads
 from stage_sim.sim.kinematics import integrate
 
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
@@ -30,6 +31,8 @@ MAX_CONFLICT_ROUNDS = 4
 # Robots refused in a round times colliding robots up to which the next round's clash test is narrowed to
 # the robots near the refused ones by a distance test (beyond, the test takes every colliding robot).
 NARROWING_PAIRS = 200_000
+# Items (points, probes, robot pairs) from which a compiled loop is shared among threads.
+PARALLEL_ITEMS = 4096
 
 
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
@@ -74,16 +77,26 @@ class GridFrame:
     resolution: float
     origin_xy: tuple[float, float]
     kernels: str = "numpy"
+    threads: int = 1  #: numba threads for the compiled loops over many items (the same answers for any)
+
+    def compiled(self, module, name: str, items: int):
+        """The compiled kernel ``name`` of ``module``, its ``_parallel`` twin (on :attr:`threads` threads)
+        when there is more than one thread and more than :data:`PARALLEL_ITEMS` items to share."""
+        if self.threads > 1 and items > PARALLEL_ITEMS:
+            set_threads(self.threads)
+            return getattr(module, name + "_parallel")
+        return getattr(module, name)
 
     def body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
         if self.kernels == "numpy":
             return point_cells(place(points, poses[pose_index]), self.resolution, self.origin_xy, self.shape)
-        from stage_sim.sim.collision_kernels import body_cells
+        from stage_sim.sim import collision_kernels
 
         out = np.empty(len(points), dtype=np.int64)
-        body_cells(points, pose_index, poses[:, 0].copy(), poses[:, 1].copy(), np.cos(poses[:, 2]),
-                   np.sin(poses[:, 2]), self.resolution, *self.origin_xy, *self.shape, out)
+        self.compiled(collision_kernels, "body_cells", len(points))(
+            points, pose_index, poses[:, 0].copy(), poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]),
+            self.resolution, *self.origin_xy, *self.shape, out)
         return out
 
 
@@ -218,7 +231,7 @@ class CollisionChecker:
         hit = np.zeros(len(poses), dtype=bool)
         for i, layer in enumerate(self._layers):
             grid = layer.grid
-            sweep_kernels.static_hits(
+            self.grid.compiled(sweep_kernels, "static_hits", len(x))(
                 self.bodies.points, self._point_start, self._point_count, x, y, cos_p, sin_p, robot,
                 self._in_layer[i], self.grid.resolution, *self.grid.origin_xy, *self.grid.shape, grid.slots,
                 grid.place, layer.tile_of_slot, layer.bits, hit)
@@ -230,12 +243,13 @@ class CollisionChecker:
         if not robots.size:
             return
         if self.grid.kernels == "numba":
-            from stage_sim.sim.collision_kernels import robots_cells
+            from stage_sim.sim import collision_kernels
 
             g = self.grid
-            robots_cells(self.bodies.points, self._point_start, self._point_count, robots, poses[:, 0].copy(),
-                         poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]), g.resolution, *g.origin_xy,
-                         *g.shape, cells)
+            kernel = g.compiled(collision_kernels, "robots_cells", int(self._point_count[robots].sum()))
+            kernel(self.bodies.points, self._point_start, self._point_count, robots, poses[:, 0].copy(),
+                   poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]), g.resolution, *g.origin_xy, *g.shape,
+                   cells)
             return
         point_index, entry = self._points_of(robots)
         cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
@@ -246,10 +260,11 @@ class CollisionChecker:
         if robots.size * self._colliding.size > NARROWING_PAIRS:
             return self._colliding
         if self.grid.kernels == "numba":
-            from stage_sim.sim.collision_kernels import near_robots
+            from stage_sim.sim import collision_kernels
 
             near = np.zeros(self._colliding.size, dtype=bool)
-            near_robots(self._colliding, robots, poses, self.bodies.radius, 2 * self.grid.resolution, near)
+            kernel = self.grid.compiled(collision_kernels, "near_robots", robots.size * self._colliding.size)
+            kernel(self._colliding, robots, poses, self.bodies.radius, 2 * self.grid.resolution, near)
             return self._colliding[near]
         others = self._colliding
         gap = poses[others, None, :2] - poses[None, robots, :2]

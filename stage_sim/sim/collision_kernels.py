@@ -1,7 +1,8 @@
 """Compiled (numba) inner loops of :mod:`stage_sim.sim.collision`, with the numpy code's arithmetic exactly.
 
 The trigonometry stays in numpy (the caller passes each pose's cos and sin, computed by the same numpy
-calls as the reference), so the cells below are the reference's cells bit for bit.
+calls as the reference), so the cells below are the reference's cells bit for bit. Loops over independent
+items have a ``_parallel`` twin for more than one thread (the same answers, spread over numba's threads).
 """
 
 from __future__ import annotations
@@ -15,35 +16,74 @@ from stage_sim.maps.tiles import TILE, TILE_BITS
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
+#: Work items of the parallel loops (points, robots): big enough that a thread's share is worth its start.
+_CHUNK = 2048
+
+
+@numba.njit(inline="always", **_JIT)
+def point_row_col(x, y, cos, sin, px, py, resolution, ox, oy):
+    """(row, col) of the grid cell under the body point (px, py) of a robot at (x, y) facing (cos, sin):
+    the numpy reference's ``point_cells(place(...))`` for one point, before the grid's bounds."""
+    return (math.floor((y + sin * px + cos * py - oy) / resolution),
+            math.floor((x + cos * px - sin * py - ox) / resolution))
+
+
+@numba.njit(inline="always", **_JIT)
+def point_cell(x, y, cos, sin, px, py, resolution, ox, oy, height, width):
+    """Flat cell (or -1 off the grid) of the body point (px, py) of a robot at (x, y) facing (cos, sin)."""
+    row, col = point_row_col(x, y, cos, sin, px, py, resolution, ox, oy)
+    return row * width + col if 0 <= col < width and 0 <= row < height else -1
+
+
+@numba.njit(inline="always", **_JIT)
+def _body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, width, out, a, b):
+    for i in range(a, b):
+        p = pose_index[i]
+        out[i] = point_cell(x[p], y[p], cos[p], sin[p], points[i, 0], points[i, 1], resolution, ox, oy, height,
+                            width)
+
+
 @numba.njit(**_JIT)
 def body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, width, out):
     """Flat cell (or -1 off the grid) of body point i placed at pose ``pose_index[i]``; the numpy
     reference is ``point_cells(place(points, poses[pose_index]))``."""
-    for i in range(points.shape[0]):
-        p = pose_index[i]
-        px = points[i, 0]
-        py = points[i, 1]
-        wx = x[p] + cos[p] * px - sin[p] * py
-        wy = y[p] + sin[p] * px + cos[p] * py
-        col = math.floor((wx - ox) / resolution)
-        row = math.floor((wy - oy) / resolution)
-        out[i] = row * width + col if 0 <= col < width and 0 <= row < height else -1
+    _body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, width, out, 0, points.shape[0])
+
+
+@numba.njit(parallel=True, **_JIT)
+def body_cells_parallel(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, width, out):
+    """:func:`body_cells`, chunks of points on numba's threads."""
+    n = points.shape[0]
+    for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
+        _body_cells(points, pose_index, x, y, cos, sin, resolution, ox, oy, height, width, out, k * _CHUNK,
+                    min(n, (k + 1) * _CHUNK))
+
+
+@numba.njit(inline="always", **_JIT)
+def _robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out, a, b):
+    for k in range(a, b):
+        p = robots[k]
+        for i in range(first[p], first[p] + count[p]):
+            out[i] = point_cell(x[p], y[p], cos[p], sin[p], points[i, 0], points[i, 1], resolution, ox, oy, height,
+                                width)
 
 
 @numba.njit(**_JIT)
 def robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out):
     """:func:`body_cells` of the points of ``robots`` only (robot r's points are ``first[r]`` on, ``count[r]``
     of them), written into their entries of ``out``."""
-    for k in range(robots.size):
-        p = robots[k]
-        for i in range(first[p], first[p] + count[p]):
-            px = points[i, 0]
-            py = points[i, 1]
-            wx = x[p] + cos[p] * px - sin[p] * py
-            wy = y[p] + sin[p] * px + cos[p] * py
-            col = math.floor((wx - ox) / resolution)
-            row = math.floor((wy - oy) / resolution)
-            out[i] = row * width + col if 0 <= col < width and 0 <= row < height else -1
+    _robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out, 0,
+                  robots.size)
+
+
+@numba.njit(parallel=True, **_JIT)
+def robots_cells_parallel(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out):
+    """:func:`robots_cells`, groups of robots on numba's threads."""
+    n = robots.size
+    step = max(1, _CHUNK // 256)
+    for k in numba.prange((n + step - 1) // step):
+        _robots_cells(points, first, count, robots, x, y, cos, sin, resolution, ox, oy, height, width, out,
+                      k * step, min(n, (k + 1) * step))
 
 
 @numba.njit(**_JIT)
@@ -78,11 +118,9 @@ def owner_clashes(cells, robots, first, count, keys, robot, used, conflict):
         keys[used[j]] = -1
 
 
-@numba.njit(**_JIT)
-def near_robots(others, robots, poses, radius, margin, near):
-    """``near[k]``: whether robot ``others[k]`` lies within touching distance of one of ``robots`` (centres
-    no farther apart than the two radii and ``margin``), as the numpy reference's distance matrix says."""
-    for k in range(others.size):
+@numba.njit(inline="always", **_JIT)
+def _near_robots(others, robots, poses, radius, margin, near, a, b):
+    for k in range(a, b):
         j = others[k]
         for i in robots:
             dx = poses[j, 0] - poses[i, 0]
@@ -90,6 +128,22 @@ def near_robots(others, robots, poses, radius, margin, near):
             if math.hypot(dx, dy) <= radius[j] + radius[i] + margin:
                 near[k] = True
                 break
+
+
+@numba.njit(**_JIT)
+def near_robots(others, robots, poses, radius, margin, near):
+    """``near[k]``: whether robot ``others[k]`` lies within touching distance of one of ``robots`` (centres
+    no farther apart than the two radii and ``margin``), as the numpy reference's distance matrix says."""
+    _near_robots(others, robots, poses, radius, margin, near, 0, others.size)
+
+
+@numba.njit(parallel=True, **_JIT)
+def near_robots_parallel(others, robots, poses, radius, margin, near):
+    """:func:`near_robots`, groups of ``others`` on numba's threads."""
+    n = others.size
+    step = 64
+    for k in numba.prange((n + step - 1) // step):
+        _near_robots(others, robots, poses, radius, margin, near, k * step, min(n, (k + 1) * step))
 
 
 @numba.njit(**_JIT)

@@ -176,8 +176,9 @@ class RangerSensing:
                 jitter=self._no_jitter if jitter is None else jitter, trig=self._trig)
             several = float(group.robot_return.max(initial=0.0))
             static = group.intensity
-            self._returns.hit_intensity(cell, hit_robot, static.cells, static.values, group.robot_return,
-                                        self._bodies.count > 1, SEVERAL_ROBOTS, several, rays, intensity)
+            kernel = self._grid.compiled(self._returns, "hit_intensity", cell.size)
+            kernel(cell, hit_robot, static.cells, static.values, group.robot_return, self._bodies.count > 1,
+                   SEVERAL_ROBOTS, several, rays, intensity)
             return
         angles = poses[owner, 2] + angle
         if jitter is not None:

@@ -238,7 +238,7 @@ class Simulation:
 
     def build_parts(self, kernels: str) -> tuple[CollisionChecker, RangerSensing]:
         """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used)."""
-        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, kernels)
+        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, kernels, self.threads)
         sensing = RangerSensing(self.robots, self.static, self._bodies, grid, kernels, self.threads)
         return self._make_collision_checker(grid), sensing
 
