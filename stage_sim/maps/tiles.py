@@ -103,7 +103,7 @@ class TileLayer:
     tile_of_slot: np.ndarray  #: (S,) int32: the layer's tile of each slot, −1 where it has no cell
     bits: np.ndarray  #: (T, TILE, TILE / 8) uint8, [tile, row in tile, col in tile / 8], bit col % 8
     derived: dict = field(default_factory=dict, compare=False, repr=False)
-    """What users compute from the layer once for all (the ray casters' free squares)."""
+    """What users compute from the layer once for all (the casters' free squares and bit masks)."""
 
     @classmethod
     def from_cells(cls, grid: TileGrid, flat: np.ndarray) -> TileLayer:
