@@ -12,9 +12,9 @@ integer line, which moves along its major axis in runs: an x-major line takes ``
 y-step, where the first run follows from the error term and every later one is ``q`` or ``q + 1`` (``q,
 rem = divmod(2·ax, 2·ay)``: ``q + 1`` when the error before the y-step is below ``rem``). So the walk takes a
 whole run of cells in one test of a row mask (a column mask for y-major lines); in a run that holds set
-bits it looks at those cells only, in the walk's order (a hit, or the ray's own robot, which it passes). The error term,
-the step count and the steps along each axis after a run are those of the step-by-step walk, so where the
-walk stops, and what it reports, are too.
+bits it looks at those cells only, in the walk's order (a hit, or the ray's own robot, which it passes).
+The error term, the step count and the steps along each axis after a run are those of the step-by-step
+walk, so where the walk stops, and what it reports, are too.
 
 Between regions, the jumps over empty regions follow Stage's floating-point crossings one by one (each
 crossing decides where the walk enters the next region holding a block). The step count they update,
