@@ -91,11 +91,11 @@ class RangerSensing:
         self._slices = self._ranger_slices()
         self._scan_slots = [(robot_index, ranger.index, part)
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
-        # the compiled path looks up intensities in one pass (numba is imported only when it runs)
+        # the compiled path looks up intensities in one pass (numba is imported only when it runs) and keeps
+        # every beam's last angle with its cos and sin (24 B a beam): a robot that did not turn (a stalled
+        # one) does not compute them again
         self._returns = import_module("stage_sim.sim.ranger_kernels") if kernels == "numba" else None
-        # and keeps every beam's last angle with its cos and sin: a robot that did not turn (a stalled one)
-        # does not compute them again
-        self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
+        self._trig = tuple(np.full(len(self._owner) if self._returns else 0, np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
