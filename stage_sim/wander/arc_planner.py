@@ -29,6 +29,7 @@ CLEARANCE_CAP = 0.15  # m of clearance beyond which more is no better
 CLEARANCE_WEIGHT = 2.5  # worth of that clearance against heading and progress (about 1 each)
 PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
 MAX_ALLOWANCE = 0.1  # m: points less certain than this are not planned with (the wanderer forgets them)
+MOVER_MARGIN = 0.15  # m more kept from points taken for another robot: it may back up blind at any moment
 
 
 class ArcPlanner:
@@ -44,7 +45,7 @@ class ArcPlanner:
         self.radius = float(np.hypot(np.abs(boxes[:, :2]).max(axis=1), np.abs(boxes[:, 2:]).max(axis=1)).max())
         # Candidates grouped by linear speed, with how far from the centre a point can matter to them.
         speeds = np.round(np.hypot(self.commands[:, 0], self.commands[:, 1]), 6)
-        margin = config.safety_distance + MAX_ALLOWANCE + CLEARANCE_CAP
+        margin = config.safety_distance + MAX_ALLOWANCE + MOVER_MARGIN + CLEARANCE_CAP
         self._groups = [(v * CHECK_TIMES[-1] + self.radius + margin, np.flatnonzero(speeds == v))
                         for v in np.unique(speeds)]
         # The arc poses as the check reads them: positions, and the cosine and sine of each yaw computed
@@ -61,7 +62,7 @@ class ArcPlanner:
     def choose(
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
         previous_turn: float, door: bool, backing: bool, turn_sign: float, reverse_room: float,
-        retreat_turn: float | None = None, wedged: bool = False,
+        retreat_turn: float | None = None, wedged: bool = False, robot: np.ndarray | None = None,
     ) -> int:
         """Index of the best command for ``heading`` (robot frame) among those whose arc keeps clear.
 
@@ -75,6 +76,8 @@ class ArcPlanner:
         the margins beyond the first check time (the body already inside them, as where a retreat, which keeps
         only half of them, ended), the arcs are checked again against half the safety distance and no drift
         allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
+        ``robot``: which points are taken for another robot's body (default none): MOVER_MARGIN more is kept from
+        them (that robot may back up blind at any moment).
         """
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
@@ -84,12 +87,13 @@ class ArcPlanner:
         order = thin[np.argsort(distance[near][thin])]
         points, allowance, distance = points[near][order], allowance[near][order], distance[near][order]
         moving = moving[near][order]
+        robot = np.zeros(len(points), dtype=bool) if robot is None else robot[near][order]
         now = self.body_distance(points[:, 0], points[:, 1])
         retreating = retreat_turn is not None
         if retreating:
             allowance = np.zeros_like(allowance)
         approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
-        margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance]
+        margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance + MOVER_MARGIN * robot]
         if wedged and not retreating:  # inside those margins (where a retreat, which keeps half, ended): half, no drift
             margins.append(np.full_like(allowance, 0.5 * config.safety_distance))
         counts = np.empty(len(self.commands), dtype=np.int64)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 
 import numpy as np
 
@@ -27,6 +28,9 @@ MOVED, MOVED_PER_M = 0.03, 0.01  # m (+ per m of range) inside last scan's free 
 SLOW_SCANS = 5  # scans back (0.5 s at 10 Hz) of the scan that near points are also held against
 SLOW_RANGE = 1.5  # m: points this near are checked for slow movers (farther ones cannot reach the body in time)
 SLOW_CONFIRM = 0.1  # m: a slow mover counts when the previous scan found one this near it too
+MOVER_S = 10.0  # s a place where another robot was seen is remembered
+MOVER_NEAR = 0.3  # m: hits this near such a place are taken for another robot's body
+MOVER_CELL = 0.05  # m: the places are thinned to the newest per cell of this size
 
 
 class ObstacleMemory:
@@ -38,14 +42,23 @@ class ObstacleMemory:
         # The latest scans, oldest first: laser pose (odometry frame) and ranges (misses at range_max).
         self._scans: deque[tuple] = deque(maxlen=SLOW_SCANS)
         self._slow = np.zeros((0, 2))  # where the previous scan found slow movers (odometry frame)
+        self._movers = np.zeros((0, 3))  # where something was seen moving in lately: x, y (odometry frame), time
 
     def update(
-        self, reading: LaserReading, pose: tuple[float, float, float], odometry: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        self, reading: LaserReading, pose: tuple[float, float, float], odometry: np.ndarray, time: float = 0.0,
+        new: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Obstacle points in the robot frame (this scan, then remembered ones out of view), their allowances,
-        and which of them are moving (nearer than the last scan put anything along their beam)."""
+        which of them are moving (nearer than the last scan put anything along their beam) and which are taken
+        for another robot's body: moving hits where ``new`` says nothing was before (odometry frame; None:
+        none is) mark the place as another robot's for MOVER_S, and hits near such a place count."""
         seen, beams = reading.points(), reading.hits()
         moving = self._approaching(reading, pose)[beams]
+        world = compose(pose, seen)
+        mover = np.zeros(len(seen), dtype=bool)
+        if new is not None and moving.any():
+            mover[moving] = new(world[moving])
+        robot = self._near_movers(world, mover, time)
         remembered = compose(pose, self._memory[:, :2], inverse=True)
         keep = reading.outside_view(remembered)
         points = np.concatenate([seen, remembered[keep]])
@@ -55,13 +68,22 @@ class ObstacleMemory:
         allowance = drift[:, 0] + drift[:, 1] * distance
         trusted = allowance <= MAX_ALLOWANCE
         moving = np.concatenate([moving, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
+        robot = np.concatenate([robot, np.zeros(len(points) - len(seen), dtype=bool)])[trusted]
         points, allowance, stamps, distance = points[trusted], allowance[trusted], stamps[trusted], distance[trusted]
         near = distance < self.radius
         world = compose(pose, points[near])
         unique = first_per_cell(world, MEMORY_CELL)
         unique.sort()  # the first of a cell is the freshest
         self._memory = np.concatenate([world[unique], stamps[near][unique]], axis=1)
-        return points, allowance, moving
+        return points, allowance, moving, robot
+
+    def _near_movers(self, world: np.ndarray, mover: np.ndarray, time: float) -> np.ndarray:
+        """Per hit (odometry frame): whether it lies within MOVER_NEAR of a place where another robot was seen
+        within MOVER_S (this scan's ``mover`` hits included), remembering this scan's."""
+        movers = np.concatenate([np.column_stack([world[mover], np.full(int(mover.sum()), time)]),
+                                 self._movers[time - self._movers[:, 2] < MOVER_S]])  # newest first
+        self._movers = movers[np.sort(first_per_cell(movers[:, :2], MOVER_CELL))]
+        return _near_any(world, self._movers[:, :2], MOVER_NEAR)
 
     def _approaching(self, reading: LaserReading, pose: tuple) -> np.ndarray:
         """Per beam: whether it hits something where the previous scan saw free space (its beam, or a

@@ -108,6 +108,7 @@ class Wanderer:
         self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
         self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
         self._wedged_until = -math.inf  # no way back at all: until then the planner may keep half its margins
+        self._robot = np.zeros(0, dtype=bool)  # which of this scan's obstacle points are taken for another robot
 
     def decide(
         self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
@@ -123,7 +124,9 @@ class Wanderer:
             self._tour_turn += turn
             self.history.extend_trail(pose, forward)
         self._pose, self._time = pose, time
-        points, allowance, moving = self.obstacles.update(reading, pose, self._odometry)
+        points, allowance, moving, robot = self.obstacles.update(reading, pose, self._odometry, time,
+                                                                 self.seen.never_occupied)
+        self._robot = robot
         self.visits.stamp(pose[0], pose[1], time)
         self._see(reading, pose)
         if self.history.stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
@@ -369,7 +372,7 @@ class Wanderer:
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
             backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,
-            retreat_turn=retreat_turn, wedged=time < self._wedged_until)
+            retreat_turn=retreat_turn, wedged=time < self._wedged_until, robot=self._robot)
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S

@@ -45,6 +45,19 @@ class SeenSpace:
         """Odometry-frame centres (..., 2) of grid indices (..., 2)."""
         return (index - self._half + 0.5) * self.cell
 
+    def never_occupied(self, xy: np.ndarray) -> np.ndarray:
+        """Per odometry-frame point (P, 2): whether no cell of the 3 × 3 block around its cell has ever scored
+        occupied (all seen free, or never seen): a hit there is something that was not there before."""
+        if not len(xy):
+            return np.zeros(0, dtype=bool)
+        side = self.score.shape[0]
+        cells = np.clip(self.index(xy), 1, side - 2)
+        worst = np.full(len(xy), np.iinfo(np.int8).min, dtype=np.int64)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                worst = np.maximum(worst, self.score[cells[:, 0] + di, cells[:, 1] + dj])
+        return worst <= 0
+
     def observe(self, origin: np.ndarray, ends: np.ndarray, hit: np.ndarray, body: np.ndarray | None = None) -> None:
         """Account for one scan: beams from ``origin`` (2,) to ``ends`` (N, 2), odometry frame; ``hit`` says
         which ended on something (the others reached the range limit). Points of ``body`` (P, 2), where the

@@ -17,7 +17,7 @@ import pytest
 from stage_sim.runs.driver import WanderDriver
 from stage_sim.runs.stats import RunStats
 from stage_sim.sim.simulation import Simulation
-from stage_sim.wander.arc_planner import ADMISSIBLE_S, CHECK_TIMES
+from stage_sim.wander.arc_planner import ADMISSIBLE_S, CHECK_TIMES, MOVER_MARGIN, ArcPlanner
 from stage_sim.wander.config import WanderConfig
 from stage_sim.wander.doorways import DoorPassage
 from stage_sim.wander.laser_reading import LaserReading
@@ -125,6 +125,26 @@ def test_boxed_in_on_three_sides_it_never_drives_forward(seed: int) -> None:
                              for x0, y0, x1, y1 in walls])
     for pose in arc_poses(np.array([command]), CHECK_TIMES[CHECK_TIMES <= ADMISSIBLE_S])[0]:
         assert body_distance(points, pose, config.footprint) > 0.0
+
+
+@pytest.mark.parametrize("gap", [0.08, 0.12])
+def test_it_drives_past_a_wall_at_its_margin_but_keeps_further_from_another_robot(gap: float) -> None:
+    """Another robot's side 0.5 m ahead on the left, ``gap`` beyond the straight path: a wall there is passed
+    at speed; a robot (it may back up blind at any moment, as in multi_robots.world seed 14) is not come
+    within safety_distance + MOVER_MARGIN of."""
+    config = WanderConfig()
+    planner = ArcPlanner(config)
+    side = np.stack([np.linspace(0.5, 0.9, 41), np.full(41, 0.15 + gap)], axis=-1)
+    commands, nearest = [], []
+    for robot in (False, True):
+        best = planner.choose(side, np.zeros(41), np.zeros(41, dtype=bool), 0.0, previous_turn=0.0, door=False,
+                              backing=False, turn_sign=0.0, reverse_room=1.0, robot=np.full(41, robot))
+        commands.append(planner.commands[best])
+        nearest.append(min(body_distance(side, pose, config.footprint)
+                           for pose in arc_poses(planner.commands[best][None], CHECK_TIMES)[0]))
+    assert commands[0][0] >= 0.3  # the wall: on at speed
+    assert nearest[1] >= config.safety_distance + MOVER_MARGIN - 1e-3
+    assert nearest[1] > nearest[0]
 
 
 def test_dead_reckons_without_odometry() -> None:
