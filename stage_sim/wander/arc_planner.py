@@ -3,8 +3,9 @@
 Each candidate command is followed along its exact arc (:func:`arc_poses`) for 1.5 s; an arc is clear while
 the body rectangles keep ``safety_distance`` (plus each point's odometry-drift allowance, plus room that grows
 at ``moving_speed`` for points seen moving in) from every obstacle point, and a point already nearer than that
-may come no nearer. Among the arcs that stay clear long enough, the one that best serves the desired heading,
-keeps clearance and leaves room to turn round wins; no command is ever zero.
+may come no nearer; another robot's body gets a wider berth (it may back up blind at any moment). Among the arcs
+that stay clear long enough, the one that best serves the desired heading, keeps clearance and leaves room to
+turn round wins; no command is ever zero.
 """
 
 from __future__ import annotations

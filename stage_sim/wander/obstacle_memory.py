@@ -7,7 +7,9 @@ turned), and forgotten once that allowance is too large to plan with. Points whe
 free space are flagged as moving: something came in, such as another robot. Near points are also held
 against the scan of SLOW_SCANS scans ago (and must pass that twice in a row): a robot reversing blind at
 0.15 m/s moves too little from one scan to the next to be told from sensor quantisation, yet would run into
-a robot that took it for a wall.
+a robot that took it for a wall. A moving hit on ground the map of seen space never saw occupied marks the place
+as another robot's for MOVER_S, and hits near such a place are taken for its body: the planner gives them a
+wider berth, since a robot may back up blind at any moment.
 """
 
 from __future__ import annotations
