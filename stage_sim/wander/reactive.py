@@ -108,7 +108,6 @@ class Wanderer:
         self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
         self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
         self._wedged_until = -math.inf  # no way back at all: until then the planner may keep half its margins
-        self._robot = np.zeros(0, dtype=bool)  # which of this scan's obstacle points are taken for another robot
 
     def decide(
         self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
@@ -126,7 +125,6 @@ class Wanderer:
         self._pose, self._time = pose, time
         points, allowance, moving, robot = self.obstacles.update(reading, pose, self._odometry, time,
                                                                  self.seen.never_occupied)
-        self._robot = robot
         self.visits.stamp(pose[0], pose[1], time)
         self._see(reading, pose)
         if self.history.stuck(time, pose):  # give up on new space around here, back out, then head somewhere else
@@ -141,7 +139,7 @@ class Wanderer:
             else:  # dithering between turns: turn one way only for a while
                 self._commit_turn(time)
         if time < self._retreat_until:
-            command = self._retreat_command(points, allowance, moving, pose, time)
+            command = self._retreat_command(points, allowance, moving, robot, pose, time)
             if command is not None:
                 self.command = command
                 return command
@@ -158,7 +156,7 @@ class Wanderer:
                     self._escape(time, wrap(pose[2] - self._side * (math.pi - 0.3)))
         if heading is None:
             heading = self._explore_heading(points, pose)
-        self.command = self._plan(points, allowance, moving, heading, time)
+        self.command = self._plan(points, allowance, moving, robot, heading, time)
         return self.command
 
     def _advance(self, time: float) -> tuple[float, float, float]:
@@ -195,7 +193,8 @@ class Wanderer:
         self._commit = (time + COMMIT_S, 1.0 if self.command[2] >= 0 else -1.0)
 
     def _retreat_command(
-        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, pose: tuple, time: float
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, robot: np.ndarray, pose: tuple,
+        time: float,
     ) -> tuple[float, ...] | None:
         """The next reverse command of the retreat; None once it is over (then, giving up, escape somewhere
         open; with no way back at all, turn one way only for a while)."""
@@ -204,7 +203,7 @@ class Wanderer:
         speed = float(self.planner.commands[:, 0].min())
         steer = self.history.retreat_turn(pose, speed, free_to_turn, until_free=self._retreat_gave_up)
         if steer is not None:
-            command = self._plan(points, allowance, moving, math.pi, time, retreat_turn=steer)
+            command = self._plan(points, allowance, moving, robot, math.pi, time, retreat_turn=steer)
             if command[0] < 0:
                 return command
         self._retreat_until = -math.inf
@@ -361,18 +360,19 @@ class Wanderer:
     # -- the safety-checked choice -----------------------------------------------------------------
 
     def _plan(
-        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, time: float,
-        retreat_turn: float | None = None,
+        self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, robot: np.ndarray, heading: float,
+        time: float, retreat_turn: float | None = None,
     ) -> tuple[float, ...]:
-        """The best command for ``heading`` whose arc keeps clear (:class:`ArcPlanner`); a reverse chosen
-        other than in a retreat or a tight spot starts a spell of backing up."""
+        """The best command for ``heading`` whose arc keeps clear (:class:`ArcPlanner`; ``moving`` and ``robot``
+        flag the points as it takes them); a reverse chosen other than in a retreat or a tight spot starts a spell
+        of backing up."""
         retreating = retreat_turn is not None
         backing = retreating or time < self._backing_until
         room = self.history.trail_length(self._pose) if retreating else self._reverse_room
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
             backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,
-            retreat_turn=retreat_turn, wedged=time < self._wedged_until, robot=self._robot)
+            retreat_turn=retreat_turn, wedged=time < self._wedged_until, robot=robot)
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
