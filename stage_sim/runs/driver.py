@@ -60,7 +60,8 @@ class WanderDriver:
         for robot, wanderer in self.wanderers.items():
             x, y, yaw = (float(v) for v in sim.odometry_poses[robot])
             pose = (x, y, through_quaternion(yaw))
-            sim.set_velocity(robot, *wanderer.decide(self.reading(robot), sim.sim_time, pose))
+            sim.set_velocity(robot, *wanderer.decide(self.reading(robot), sim.sim_time, pose,
+                                                     bool(sim.stalled[robot])))
 
 
 def _float32(value: float) -> float:

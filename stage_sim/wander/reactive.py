@@ -14,7 +14,9 @@ the body closer to a point than ``safety_distance`` (or than it already is), so 
 has seen. Dithering in place (no net motion for half a second) is broken by turning one way only, then by
 backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot gives up what lay
 ahead and retraces in reverse the path it last drove forward, the only ground behind it known to be clear,
-until it can turn round.
+until it can turn round. Should the simulator report a stall all the same (the last move refused: something
+the laser did not show, such as another robot that came into the blind rear), a reversing robot stops
+reversing for BUMPED_S and a turning one turns the other way: odometry would not show that the body stands.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ DOOR_RECENT_S = 120.0  # s: touring, a doorway is taken unless its far side was 
 REVERSE_ROOM_MAX = 1.0  # m of the path just driven forward that a reverse may take back (the rear is blind)
 RETREAT_S = 12.0  # s a retreat may last
 COMMIT_S = 2.0  # s of turning one way only when dithering and unable to back out
+BUMPED_S = 3.0  # s without reversing after the body touched something behind it
 ROUTE_S = 3.0  # s a route to far new space is followed before it is planned afresh
 ROUTE_AHEAD = 1.0  # m along the route of the point a seeking robot heads for
 ROUTE_OFF = 1.0  # m off its route at which a seeking robot plans a new one
@@ -108,11 +111,14 @@ class Wanderer:
         self._retreat_gave_up = False  # the retreat abandons what lay ahead (else it only makes room for another try)
         self._commit = (-math.inf, 1.0)  # until when turns must go the one way given (+1: left)
         self._wedged_until = -math.inf  # no way back at all: until then the planner may keep half its margins
+        self._rear_blocked_until = -math.inf  # touched something behind: no reversing until then
 
     def decide(
-        self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None
+        self, reading: LaserReading, time: float, pose: tuple[float, float, float] | None = None,
+        stalled: bool = False,
     ) -> tuple[float, float, float]:
-        """The command (vx, vy, wz) for this scan; ``pose`` is odometry (dead reckoning if None)."""
+        """The command (vx, vy, wz) for this scan; ``pose`` is odometry (dead reckoning if None); ``stalled``:
+        the simulator refused the last move (the body touches something)."""
         pose = self._advance(time) if pose is None else tuple(float(v) for v in pose)
         if self._pose is not None:
             turn = float(wrap(pose[2] - self._pose[2]))
@@ -138,6 +144,8 @@ class Wanderer:
                 self._retreat(time, pose, give_up=False)
             else:  # dithering between turns: turn one way only for a while
                 self._commit_turn(time)
+        if stalled:  # after the standing-still rules, whose turn commitment would repeat the bumping turn
+            self._bumped(time)
         if time < self._retreat_until:
             command = self._retreat_command(points, allowance, moving, robot, pose, time)
             if command is not None:
@@ -187,6 +195,18 @@ class Wanderer:
         self._retreat_gave_up = give_up
         self._retreat_until = time + RETREAT_S
         self.history.start_retreat(pose)
+
+    def _bumped(self, time: float) -> None:
+        """The last command ran the body into something the laser did not show: reversing, something behind
+        it (another robot that came into the blind rear): no more reversing for a while, the retreat or
+        backing spell is over; turning, a rear corner swung into it: turn the other way for a while."""
+        vx, _, wz = self.command
+        if vx < 0:  # the way it came is no longer known to be clear
+            self._rear_blocked_until = time + BUMPED_S
+            self._retreat_until = self._backing_until = -math.inf
+            self._reverse_room = 0.0
+        elif wz != 0:
+            self._commit = (time + COMMIT_S, -1.0 if wz > 0 else 1.0)
 
     def _commit_turn(self, time: float) -> None:
         """Turn only the way the robot is turning now, for COMMIT_S (dithering between the two ends nowhere)."""
@@ -369,6 +389,8 @@ class Wanderer:
         retreating = retreat_turn is not None
         backing = retreating or time < self._backing_until
         room = self.history.trail_length(self._pose) if retreating else self._reverse_room
+        if time < self._rear_blocked_until:
+            room = 0.0
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
             backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,

@@ -15,11 +15,15 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool
 
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.wander import Wander
+from stage_sim.wander.reactive import BUMPED_S
 from stage_sim.worldfile.bundled import find_world
 from tests.ros.helpers import spin_until
+from tests.wander.test_reactive import POCKET_SIDES, scan_of_segments
 
 WANDER = Path(sys.executable).with_name("wander")
 
@@ -74,6 +78,51 @@ def test_each_robot_of_a_multi_robot_world_has_its_own_wanderer(ros_context, exe
     assert [len(c) for c in commands.values()] == [50] * 4
     assert all(math.hypot(*(stage.sim.true_poses[i][:2] - start[i][:2])) > 0.5 for i in range(4))
     assert not stage.sim.stalled.any()
+
+
+def test_a_stall_on_the_stall_topic_ends_the_reversing_that_caused_it(ros_context, executor) -> None:
+    # Scans and odometry of a robot driving into a pocket too narrow to turn in, which it must back out of;
+    # then stageros reports a stall (something came into the blind rear): no more reversing for BUMPED_S.
+    wander = Wander(namespace="r", context=ros_context, parameter_overrides=[Parameter("seed", value=0)])
+    probe = Node("probe", context=ros_context)
+    executor.add_node(wander)
+    executor.add_node(probe)
+    scans = probe.create_publisher(LaserScan, "/r/base_scan", 10)
+    odoms = probe.create_publisher(Odometry, "/r/odom", 10)
+    stall = probe.create_publisher(Bool, "/r/stall", 10)
+    commands: list[Twist] = []
+    probe.create_subscription(Twist, "/r/cmd_vel", commands.append, 100)
+    assert spin_until(executor, lambda: scans.get_subscription_count() and odoms.get_subscription_count()
+                      and stall.get_subscription_count() and wander.publisher.get_subscription_count(), 10.0)
+
+    def scan_and_odometry(step: int, x: float, end: float) -> float:
+        """Publish the odometry and scan of ``step``, wait for the command; returns its linear speed."""
+        reading = scan_of_segments([*POCKET_SIDES, (end, -1.0, end, 1.0)])
+        odom, scan = Odometry(), LaserScan()
+        for msg in (odom, scan):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(step * 100_000_000, 1_000_000_000)
+        odom.pose.pose.position.x = x
+        odom.pose.pose.orientation.w = 1.0
+        scan.header.frame_id = "base_laser_link"
+        scan.angle_min, scan.angle_increment = reading.angle_min, reading.angle_increment
+        scan.range_min, scan.range_max = reading.range_min, reading.range_max
+        scan.ranges = [float(r) for r in reading.ranges]
+        count = len(commands)
+        odoms.publish(odom)
+        scans.publish(scan)
+        assert spin_until(executor, lambda: len(commands) > count, 5.0)
+        return commands[-1].linear.x
+
+    for step in range(14):  # into the pocket, 5 cm a scan
+        scan_and_odometry(step, 0.05 * step, 1.0 - 0.05 * step)
+    assert all(scan_and_odometry(step, 0.7, 0.285) < 0 for step in range(14, 20))  # at its end: backing out
+    stall.publish(Bool(data=True))
+    assert spin_until(executor, lambda: wander._stalled, 5.0)
+    after = [scan_and_odometry(20, 0.7, 0.285)]
+    stall.publish(Bool(data=False))
+    assert spin_until(executor, lambda: not wander._stalled, 5.0)
+    after += [scan_and_odometry(step, 0.7, 0.285) for step in range(21, 20 + round(BUMPED_S * 10))]
+    assert all(speed >= 0 for speed in after)
 
 
 @pytest.mark.slow

@@ -21,7 +21,7 @@ from stage_sim.wander.arc_planner import ADMISSIBLE_S, CHECK_TIMES, MOVER_MARGIN
 from stage_sim.wander.config import WanderConfig
 from stage_sim.wander.doorways import DoorPassage
 from stage_sim.wander.laser_reading import LaserReading
-from stage_sim.wander.reactive import Wanderer
+from stage_sim.wander.reactive import BUMPED_S, Wanderer
 from stage_sim.wander.velocity_arcs import arc_poses, candidate_commands
 from stage_sim.wander.visit_map import VisitMap
 
@@ -153,6 +153,43 @@ def test_dead_reckons_without_odometry() -> None:
     for step in range(20):
         command = wanderer.decide(reading, step * 0.1, None)
         assert all(math.isfinite(v) for v in command) and command != (0.0, 0.0, 0.0)
+
+
+POCKET_SIDES = [(-3.0, 0.21, 3.0, 0.21), (-3.0, -0.21, 3.0, -0.21)]  # a pocket too narrow to turn round in
+
+
+def backing_out_of_a_pocket(wanderer: Wanderer) -> float:
+    """Drive ``wanderer`` 0.65 m into the pocket until its end is 3 cm ahead, then let it back up (it must);
+    returns the time of its next scan."""
+    x = 0.0
+    for step in range(14):  # forward into the pocket (the way back is the path just driven)
+        wanderer.decide(scan_of_segments([*POCKET_SIDES, (1.0 - x, -1.0, 1.0 - x, 1.0)]), step * 0.1, (x, 0.0, 0.0))
+        x += 0.05
+    end = scan_of_segments([*POCKET_SIDES, (0.285, -1.0, 0.285, 1.0)])
+    for step in range(14, 20):
+        assert wanderer.decide(end, step * 0.1, (x, 0.0, 0.0))[0] < 0  # backing out
+    return 2.0
+
+
+def test_touching_something_behind_while_reversing_stops_the_reversing() -> None:
+    # Another robot came into the blind rear: the simulator refuses the move (Stage's stall) and says so.
+    wanderer = Wanderer(seed=0)
+    t = backing_out_of_a_pocket(wanderer)
+    end = scan_of_segments([*POCKET_SIDES, (0.285, -1.0, 0.285, 1.0)])
+    commands = [wanderer.decide(end, t, (0.65, 0.0, 0.0), stalled=True)]
+    while t < 2.0 + BUMPED_S - 0.05:
+        t += 0.1
+        commands.append(wanderer.decide(end, t, (0.65, 0.0, 0.0)))
+    assert all(vx >= 0 and (vx, vy, wz) != (0.0, 0.0, 0.0) for vx, vy, wz in commands)
+
+
+def test_touching_something_while_turning_in_place_turns_the_other_way() -> None:
+    wanderer = Wanderer(seed=0)
+    end = scan_of_segments([(0.3, -2.0, 0.3, 2.0), (-1.0, 0.3, 0.3, 0.3), (-1.0, -0.3, 0.3, -0.3)])
+    turns = [wanderer.decide(end, step * 0.1, (0.0, 0.0, 0.0))[2] for step in range(10)]
+    assert len(set(np.sign(turns))) == 1 and turns[0] != 0  # a wall ahead and walls beside: turning in place
+    after = [wanderer.decide(end, (10 + step) * 0.1, (0.0, 0.0, 0.0), stalled=step == 0)[2] for step in range(10)]
+    assert all(np.sign(turn) == -np.sign(turns[0]) for turn in after)  # a rear corner hit: the other way
 
 
 # -- closed loop in small worlds ------------------------------------------------------------------------------
