@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import gymnasium
 import numpy as np
@@ -23,8 +24,25 @@ def make(**kwargs) -> NavigateEnv:
 
 
 def test_check_env_passes_for_the_continuous_and_the_discrete_variant():
-    check_env(gymnasium.make(ENV_ID, body=SMALL, render_mode="rgb_array").unwrapped)
-    check_env(gymnasium.make(ENV_ID, body=SMALL, discrete=True).unwrapped)
+    # Its one remark: the Box of actions is in physical units (m/s, rad/s), not [-1, 1] (see the README).
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(gymnasium.make(ENV_ID, body=SMALL, render_mode="rgb_array").unwrapped)
+    assert [str(w.message) for w in caught if "symmetric and normalized" not in str(w.message)] == []
+    assert len(caught) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(gymnasium.make(ENV_ID, body=SMALL, discrete=True).unwrapped)
+
+
+def test_gymnasiums_rescale_wrapper_gives_a_plus_minus_one_box_mapped_onto_the_velocity_bounds():
+    low, high = np.full(2, -1.0, dtype=np.float32), np.full(2, 1.0, dtype=np.float32)
+    env = gymnasium.wrappers.RescaleAction(gymnasium.make(ENV_ID, body=SMALL), low, high)
+    assert env.action_space.low.tolist() == [-1.0, -1.0] and env.action_space.high.tolist() == [1.0, 1.0]
+    env.reset(seed=1)
+    env.step(np.array([1.0, -1.0], dtype=np.float32))
+    assert env.unwrapped.task.sim.commands[0, 0] == pytest.approx(1.0)  # v_max
+    assert env.unwrapped.task.sim.commands[0, 2] == pytest.approx(-math.pi / 2)  # ω_min
 
 
 def test_observation_holds_k_scans_goal_and_velocity_and_actions_follow_the_velocity_bounds():
