@@ -3,9 +3,9 @@
 Each candidate command is followed along its exact arc (:func:`arc_poses`) for 1.5 s; an arc is clear while
 the body rectangles keep ``safety_distance`` (plus each point's odometry-drift allowance, plus room that grows
 at ``moving_speed`` for points seen moving in) from every obstacle point, and a point already nearer than that
-may come no nearer; another robot's body gets a wider berth (it may back up blind at any moment). Among the arcs
-that stay clear long enough, the one that best serves the desired heading, keeps clearance and leaves room to
-turn round wins; no command is ever zero.
+may come no nearer (a body moving in close must be got away from). Another robot's body gets a wider berth: it
+may back up blind at any moment. Among the arcs that stay clear long enough, the one that best serves the
+desired heading, keeps clearance and leaves room to turn round wins; no command is ever zero.
 """
 
 from __future__ import annotations
@@ -31,6 +31,9 @@ CLEARANCE_WEIGHT = 2.5  # worth of that clearance against heading and progress (
 PLAN_CELL = 0.02  # m: points are thinned to one per cell of this size for the arc checks
 MAX_ALLOWANCE = 0.1  # m: points less certain than this are not planned with (the wanderer forgets them)
 MOVER_MARGIN = 0.15  # m more kept from points taken for another robot: it may back up blind at any moment
+FLEE_RANGE = 0.3  # m: a body moving in this near (FLEE_POINTS of its points at least) must be got away from...
+FLEE_POINTS = 8  # ...(fewer moving points this near are quantisation at a wall or a jamb, not a body)...
+FLEE_SPEED = 0.1  # m/s: ...at this speed (another robot backing up blind at 0.15 m/s will not stop for us)
 
 
 class ArcPlanner:
@@ -64,6 +67,7 @@ class ArcPlanner:
         self, points: np.ndarray, allowance: np.ndarray, moving: np.ndarray, heading: float, *,
         previous_turn: float, door: bool, backing: bool, turn_sign: float, reverse_room: float,
         retreat_turn: float | None = None, wedged: bool = False, robot: np.ndarray | None = None,
+        flee_room: float | None = None,
     ) -> int:
         """Index of the best command for ``heading`` (robot frame) among those whose arc keeps clear.
 
@@ -78,7 +82,12 @@ class ArcPlanner:
         only half of them, ended), the arcs are checked again against half the safety distance and no drift
         allowance, so that a robot wedged against a wall it may not come nearer still finds a way out.
         ``robot``: which points are taken for another robot's body (default none): MOVER_MARGIN more is kept from
-        them (that robot may back up blind at any moment).
+        them (that robot may back up blind at any moment). A body moving in within FLEE_RANGE (FLEE_POINTS of its
+        points, taken for a robot or not: one that stood still a while is part of the map) must be got away from
+        at FLEE_SPEED (keeping the present distance does not do against a robot backing up blind) if any arc
+        does so long enough; if none does, holding the present distance will do (asking the impossible made two
+        robots that each took the other's dithering for coming on stand off for minutes). Fleeing, a reverse may
+        take ``flee_room`` metres (the whole path the robot came by: another robot's blind retreat can be that long).
         """
         config = self.config
         # How near each point could come within the horizon: moving ones come nearer.
@@ -94,26 +103,38 @@ class ArcPlanner:
         if retreating:
             allowance = np.zeros_like(allowance)
         approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
-        margins = [config.safety_distance * (0.5 if backing else 1.0) + allowance + MOVER_MARGIN * robot]
+        closing = moving & (now < FLEE_RANGE)
+        margin = config.safety_distance * (0.5 if backing else 1.0) + allowance + MOVER_MARGIN * robot
+        # Passes of (margin, least distance (T, P) for points already inside it), until one leaves something to
+        # do: getting away from a body moving in (its nearest point's distance growing), if any arc does; else
+        # holding the present distance; wedged, half margins.
+        hold = np.broadcast_to(now - TOLERANCE, (len(CHECK_TIMES), len(now)))
+        passes = [(margin, hold, reverse_room)]
+        if closing.sum() >= FLEE_POINTS:
+            away = now[closing].min() - TOLERANCE + FLEE_SPEED * CHECK_TIMES[:, None]
+            room = reverse_room if flee_room is None else max(reverse_room, flee_room)
+            passes.insert(0, (margin, np.where(closing, away, hold), room))
         if wedged and not retreating:  # inside those margins (where a retreat, which keeps half, ended): half, no drift
-            margins.append(np.full_like(allowance, 0.5 * config.safety_distance))
+            passes.append((np.full_like(allowance, 0.5 * config.safety_distance), hold, reverse_room))
         counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
             counts[rows] = np.searchsorted(distance, reach)
         px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
         speed = self.commands[:, 0]
-        reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= reverse_room)
-        for margin in margins:
+        for margin, least, room in passes:
+            reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= room)
             keep_off = margin + approach
-            limit = np.where(now > keep_off, keep_off, now - TOLERANCE)
+            limit = np.where(now > keep_off, keep_off, np.minimum(least, keep_off))
             # (C, T): least margin to any point; < 0 is a hit (and what follows a hit is not looked at)
             closest = kernels.arc_margins(self._x, self._y, self._cos, self._sin, counts, px, py, distance,
                                           np.ascontiguousarray(limit), self.boxes, self.radius)
             hit = np.logical_or.accumulate(closest < 0, axis=1)
             safe_until = np.where(hit.any(axis=1), SAFE_TIMES[np.argmax(hit, axis=1)], CHECK_TIMES[-1])
             admissible = (safe_until >= ADMISSIBLE_S) & reversible
-            if admissible.any() or np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
-                break  # something stays clear (if not long enough: of what may be done, the longest)
+            if admissible.any():
+                break  # something stays clear long enough
+            if least is hold and np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
+                break  # of what may be done (no fleeing asked), the longest clear
         clearance = np.where(hit, np.inf, closest).min(axis=1)
         look_x, look_y, look_yaw = self._look.T
         progress = (look_x * math.cos(heading) + look_y * math.sin(heading)) / (config.forward_speed * LOOK_AHEAD_S)

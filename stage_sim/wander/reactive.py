@@ -11,8 +11,10 @@ door and round every room), the side redrawn by a seeded generator; (3) picks, f
 commands, the one that best serves that heading while the body, simulated along the command's arc, keeps
 clear of every point (:class:`ArcPlanner`, a dynamic-window check). No command is ever zero, and none brings
 the body closer to a point than ``safety_distance`` (or than it already is), so it never drives into what it
-has seen. Dithering in place (no net motion for half a second) is broken by turning one way only, then by
-backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot gives up what lay
+has seen; other robots, which back up blind, get a wider berth and are got away from when they come on (a
+reverse may then take the whole path the robot came by).
+Dithering in place (no net motion for half a second) is broken by turning one way only, then by backing off
+0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot gives up what lay
 ahead and retraces in reverse the path it last drove forward, the only ground behind it known to be clear,
 until it can turn round. Should the simulator report a stall all the same (the last move refused: something
 the laser did not show, such as another robot that came into the blind rear), a reversing robot stops
@@ -388,13 +390,14 @@ class Wanderer:
         of backing up."""
         retreating = retreat_turn is not None
         backing = retreating or time < self._backing_until
-        room = self.history.trail_length(self._pose) if retreating else self._reverse_room
+        trail = self.history.trail_length(self._pose)
+        room = trail if retreating else self._reverse_room
         if time < self._rear_blocked_until:
-            room = 0.0
+            room = trail = 0.0
         best = self.planner.choose(
             points, allowance, moving, heading, previous_turn=self.command[2], door=self.mode == "door",
             backing=backing, turn_sign=self._commit[1] if time < self._commit[0] else 0.0, reverse_room=room,
-            retreat_turn=retreat_turn, wedged=time < self._wedged_until, robot=robot)
+            retreat_turn=retreat_turn, wedged=time < self._wedged_until, robot=robot, flee_room=trail)
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
