@@ -105,23 +105,23 @@ class ArcPlanner:
         approach = np.outer(CHECK_TIMES, moving * config.moving_speed)  # (T, P): room for points moving in
         closing = moving & (now < FLEE_RANGE)
         margin = config.safety_distance * (0.5 if backing else 1.0) + allowance + MOVER_MARGIN * robot
-        # Passes of (margin, least distance (T, P) for points already inside it), until one leaves something to
-        # do: getting away from a body moving in (its nearest point's distance growing), if any arc does; else
-        # holding the present distance; wedged, half margins.
+        # Passes of (margin, least distance (T, P) for points already inside it, reverse room, fleeing), until one
+        # leaves something to do: getting away from a body moving in (its nearest point's distance growing), if
+        # any arc does; else holding the present distance; wedged, half margins.
         hold = np.broadcast_to(now - TOLERANCE, (len(CHECK_TIMES), len(now)))
-        passes = [(margin, hold, reverse_room)]
+        passes = [(margin, hold, reverse_room, False)]
         if closing.sum() >= FLEE_POINTS:
             away = now[closing].min() - TOLERANCE + FLEE_SPEED * CHECK_TIMES[:, None]
             room = reverse_room if flee_room is None else max(reverse_room, flee_room)
-            passes.insert(0, (margin, np.where(closing, away, hold), room))
+            passes.insert(0, (margin, np.where(closing, away, hold), room, True))
         if wedged and not retreating:  # inside those margins (where a retreat, which keeps half, ended): half, no drift
-            passes.append((np.full_like(allowance, 0.5 * config.safety_distance), hold, reverse_room))
+            passes.append((np.full_like(allowance, 0.5 * config.safety_distance), hold, reverse_room, False))
         counts = np.empty(len(self.commands), dtype=np.int64)
         for reach, rows in self._groups:  # a slow arc only needs the points it can reach
             counts[rows] = np.searchsorted(distance, reach)
         px, py = np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1])
         speed = self.commands[:, 0]
-        for margin, least, room in passes:
+        for margin, least, room, fleeing in passes:
             reversible = (speed >= 0) | (-speed * ADMISSIBLE_S <= room)
             keep_off = margin + approach
             limit = np.where(now > keep_off, keep_off, np.minimum(least, keep_off))
@@ -133,7 +133,7 @@ class ArcPlanner:
             admissible = (safe_until >= ADMISSIBLE_S) & reversible
             if admissible.any():
                 break  # something stays clear long enough
-            if least is hold and np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
+            if not fleeing and np.where(reversible, safe_until, 0.0).max() > CHECK_TIMES[0]:
                 break  # of what may be done (no fleeing asked), the longest clear
         clearance = np.where(hit, np.inf, closest).min(axis=1)
         look_x, look_y, look_yaw = self._look.T
