@@ -13,12 +13,13 @@ clear of every point (:class:`ArcPlanner`, a dynamic-window check). No command i
 the body closer to a point than ``safety_distance`` (or than it already is), so it never drives into what it
 has seen; other robots, which back up blind, get a wider berth and are got away from when they come on (a
 reverse may then take the whole path the robot came by).
-Dithering in place (no net motion for half a second) is broken by turning one way only, then by backing off
-0.3 m; stuck for longer (a dead end too narrow to turn round in), the robot gives up what lay
-ahead and retraces in reverse the path it last drove forward, the only ground behind it known to be clear,
-until it can turn round. Should the simulator report a stall all the same (the last move refused: something
-the laser did not show, such as another robot that came into the blind rear), a reversing robot stops
-reversing for BUMPED_S and a turning one turns the other way: odometry would not show that the body stands.
+Dithering in place (no net motion for half a second) is broken by turning one way only (the other way once
+that one is blocked), then by backing off 0.3 m; stuck for longer (a dead end too narrow to turn round in),
+the robot gives up what lay ahead and retraces in reverse the path it last drove forward, the only ground
+behind it known to be clear, until it can turn round. Should the simulator report a stall all the same (the
+last move refused: something the laser did not show, such as another robot that came into the blind rear), a
+reversing robot stops reversing for BUMPED_S and a turning one turns the other way: odometry would not show
+that the body stands.
 """
 
 from __future__ import annotations
@@ -401,4 +402,7 @@ class Wanderer:
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
+        sign = self._commit[1]
+        if time < self._commit[0] and not retreating and (command[2] * sign < 0 or command[1] * sign < 0):
+            self._commit = (self._commit[0], -sign)  # the way committed to is blocked: the other way it is
         return tuple(float(v) for v in command)

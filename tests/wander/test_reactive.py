@@ -7,6 +7,7 @@ distance and coverage, the figures the launch scripts print.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +31,7 @@ from stage_sim.wander.arc_planner import (
 )
 from stage_sim.wander.config import WanderConfig
 from stage_sim.wander.doorways import DoorPassage
+from stage_sim.wander.frames import compose
 from stage_sim.wander.laser_reading import LaserReading
 from stage_sim.wander.reactive import BUMPED_S, Wanderer
 from stage_sim.wander.velocity_arcs import arc_poses, candidate_commands
@@ -267,6 +269,34 @@ def test_touching_something_while_turning_in_place_turns_the_other_way() -> None
     assert len(set(np.sign(turns))) == 1 and turns[0] != 0  # a wall ahead and walls beside: turning in place
     after = [wanderer.decide(end, (10 + step) * 0.1, (0.0, 0.0, 0.0), stalled=step == 0)[2] for step in range(10)]
     assert all(np.sign(turn) == -np.sign(turns[0]) for turn in after)  # a rear corner hit: the other way
+
+
+# A funnel as in multi_robots.world (seed 16 of the sweep): walls converging ahead, one a few cm off a front
+# corner, the way out behind. Turning towards that wall is blocked; turning the other way frees it again.
+FUNNEL = [(-0.5, 0.42, 0.9, -0.03), (-0.5, -0.5, 0.9, -0.75), (0.9, -0.03, 0.9, -0.75)]
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_a_turn_committed_to_and_blocked_gives_way_to_the_other_so_a_wedged_robot_turns_round(
+    seed: int, mirrored: bool,
+) -> None:
+    # A stall on the first turn commits the robot to the other way (as a rear corner hitting something does);
+    # where that way is blocked, keeping to it made a left-right-left cycle with no net turn for minutes.
+    walls = [(x0, -y0, x1, -y1) for x0, y0, x1, y1 in FUNNEL] if mirrored else FUNNEL
+    wanderer = Wanderer(seed=seed)
+    pose, turns, headings = (0.0, 0.0, 0.0), [], []
+    for step in range(50):  # 5 s, the scans following the true motion
+        local = [tuple(compose(pose, np.array([[x0, y0], [x1, y1]]), inverse=True).ravel())
+                 for x0, y0, x1, y1 in walls]
+        command = wanderer.decide(scan_of_segments(local), step * 0.1, pose, stalled=step == 1)
+        motion = arc_poses(np.array([command]), np.array([0.1]))[0, 0]
+        pose = (*compose(pose, motion[None, :2])[0], pose[2] + motion[2])
+        turns.append(np.sign(command[2]))
+        headings.append(pose[2])
+    ways = [turn for turn in turns if turn != 0]
+    assert sum(a != b for a, b in itertools.pairwise(ways)) <= 4  # no back and forth
+    assert max(abs(h) for h in headings) > math.radians(80)  # it turns round towards the way out
 
 
 # -- closed loop in small worlds ------------------------------------------------------------------------------
