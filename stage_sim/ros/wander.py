@@ -3,9 +3,10 @@
 Subscribes ``base_scan``, ``odom`` and ``stall`` (relative, so a namespace selects the robot) and publishes one
 ``geometry_msgs/Twist`` on ``cmd_vel`` per scan, decided by :class:`stage_sim.wander.reactive.Wanderer`
 (see there for the strategy). Each scan is paired with the odometry of the same stamp, so the remembered
-obstacle points behind the robot stay where they were; the latest ``stall`` (std_msgs/Bool, stageros publishes
-it every step before the scans) tells the wanderer that its last command ran the body into something its laser
-did not show. The laser's mounting comes from ``/tf_static``
+obstacle points behind the robot stay where they were; a ``stall`` (std_msgs/Bool, stageros publishes it every
+step before the scans) that was true at any time since the last scan tells the wanderer that its last command
+ran the body into something its laser did not show (so a stall is never lost, should the next step's flag
+come in before the scan it belongs with). The laser's mounting comes from ``/tf_static``
 (parameter ``laser_pose`` until it has arrived). Parameters: ``forward_speed`` (m/s), ``safety_distance`` (m),
 ``turn_rate`` (rad/s), ``holonomic`` (omni drive), ``seed`` (-1: random), ``footprint`` (the body as
 rectangles, flattened ``[x_min, x_max, y_min, y_max, ...]``), ``laser_pose`` ``[x, y, yaw]``.
@@ -76,7 +77,7 @@ class Wander(Node):
         self.laser_poses: dict[str, tuple[float, float, float]] = {}  # frame -> pose on the robot, from /tf_static
         self._odometry: deque[tuple[int, tuple[float, float, float]]] = deque(maxlen=ODOM_KEPT)
         self._pending: LaserScan | None = None  # a scan waiting for the odometry of its stamp
-        self._stalled = False  # the latest stall flag of the robot
+        self._stalled = False  # whether a stall was reported since the last decision
         self.publisher = self.create_publisher(Twist, "cmd_vel", RELIABLE_10)
         # Created first: when a step's stall and scan are both waiting, the executor takes the stall first.
         self.create_subscription(Bool, "stall", self.on_stall, RELIABLE_10)
@@ -91,7 +92,7 @@ class Wander(Node):
             self.laser_poses[transform.child_frame_id] = (t.translation.x, t.translation.y, _yaw(t.rotation))
 
     def on_stall(self, msg: Bool) -> None:
-        self._stalled = bool(msg.data)
+        self._stalled = self._stalled or bool(msg.data)
 
     def on_odom(self, msg: Odometry) -> None:
         p = msg.pose.pose
@@ -117,6 +118,7 @@ class Wander(Node):
             np.asarray(scan.ranges, dtype=np.float64), scan.angle_min, scan.angle_increment, scan.range_min,
             scan.range_max, self.laser_poses.get(scan.header.frame_id, self.default_laser_pose))
         vx, vy, wz = self.wanderer.decide(reading, _nanoseconds(scan.header.stamp) / 1e9, pose, self._stalled)
+        self._stalled = False
         msg = Twist()
         msg.linear.x, msg.linear.y, msg.angular.z = vx, vy, wz
         self.publisher.publish(msg)
