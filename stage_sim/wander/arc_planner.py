@@ -143,7 +143,7 @@ class ArcPlanner:
                  - 0.2 * np.abs(self.commands[:, 2] - previous_turn) / config.turn_rate
                  - (1.0 if door else 8.0) * self._cramped(px, py, distance)
                  - np.where(backing, speed > 0, speed < 0)  # reverse only to get out, then only until free
-                 - 3.0 * ((self.commands[:, 2] * turn_sign < 0) | (self.commands[:, 1] * turn_sign < 0)))
+                 - 3.0 * self.against(turn_sign))
         if retreating and (admissible & (speed < 0)).any():
             admissible &= speed < 0
             score = -np.abs(self.commands[:, 2] - retreat_turn) - np.abs(self.commands[:, 1])
@@ -152,6 +152,10 @@ class ArcPlanner:
             admissible = longest == longest.max()
             score = closest[:, 0]
         return int(np.argmax(np.where(admissible, score, -np.inf)))
+
+    def against(self, turn_sign: float) -> np.ndarray:
+        """Which commands (C,) turn or move sideways against ``turn_sign`` (+1: left; 0: none do)."""
+        return (self.commands[:, 2] * turn_sign < 0) | (self.commands[:, 1] * turn_sign < 0)
 
     def _cramped(self, px: np.ndarray, py: np.ndarray, near: np.ndarray) -> np.ndarray:
         """How far (m) points intrude into the turning circle at each candidate's half-second pose (C,); the

@@ -402,7 +402,7 @@ class Wanderer:
         command = self.planner.commands[best]
         if command[0] < 0 and not backing:
             self._backing_until = time + BACKING_S
-        sign = self._commit[1]
-        if time < self._commit[0] and not retreating and (command[2] * sign < 0 or command[1] * sign < 0):
-            self._commit = (self._commit[0], -sign)  # the way committed to is blocked: the other way it is
+        until, sign = self._commit
+        if time < until and not retreating and self.planner.against(sign)[best]:
+            self._commit = (until, -sign)  # the way committed to is blocked: the other way it is
         return tuple(float(v) for v in command)
