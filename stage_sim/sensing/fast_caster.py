@@ -4,7 +4,7 @@ Same inputs, same :class:`~stage_sim.sensing.raycast.CastResult`, bit for bit (`
 cosines and sines of the angles come from the very numpy calls the reference makes, and the kernel computes
 the rest of Stage's per-ray constants (:class:`~stage_sim.sensing.stage_walk.WalkRays`) operation for operation.
 
-Memory: the static layer's bit rows and columns, 256 B per tile (only the world's regions holding a cell at
+Memory: the static layer's bit rows and columns, 264 B per tile (only the world's regions holding a cell at
 this height: :mod:`stage_sim.maps.tiles`), the tile grid's region index (4 B per region) shared with the
 world, and the robot layer (:class:`~stage_sim.sensing.robot_layer.RobotLayer`).
 """
@@ -42,8 +42,8 @@ class NumbaRayCaster:
         self.height, self.width = layer.grid.shape
         self.threads = threads
         self._grid = layer.grid
-        rows, cols = bit_rows_and_columns(layer)
-        self._world = (rows, cols, layer.tile_of_slot, layer.grid.slots)
+        rows, cols, rows_used, cols_used = bit_masks(layer)
+        self._world = (rows, cols, layer.tile_of_slot, layer.grid.slots, rows_used, cols_used)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
                            np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32))
@@ -96,16 +96,18 @@ class NumbaRayCaster:
         return cell, hit_robot
 
 
-def bit_rows_and_columns(layer: TileLayer) -> tuple[np.ndarray, np.ndarray]:
-    """(T, 32) uint32 row masks (bit x of row y: cell (y, x)) and column masks (bit y of column x) of the
-    layer's tiles, computed the first time only and kept with the layer (the casters of two heights that see
-    the same cells share them)."""
-    if "bit_rows" not in layer.derived:
+def bit_masks(layer: TileLayer) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The layer's tiles as the compiled walk reads them: (T, 32) uint32 row masks (bit x of row y: cell (y,
+    x)), column masks (bit y of column x), and per tile a uint32 of the rows (columns) holding a cell, which
+    let the walk cross empty rows (columns) at once. Computed the first time only and kept with the layer
+    (the casters of two heights that see the same cells share them)."""
+    if "bit_masks" not in layer.derived:
         bits = np.ascontiguousarray(layer.bits)
         rows = bits.view("<u4").reshape(bits.shape[0], bits.shape[1]).astype(np.uint32)
         weights = np.uint32(1) << np.arange(rows.shape[1], dtype=np.uint32)
         cols = np.empty_like(rows)
         for x in range(rows.shape[1]):  # column x: bit y is bit x of row y
             cols[:, x] = ((rows >> np.uint32(x)) & np.uint32(1)) @ weights
-        layer.derived["bit_rows"] = (rows, cols)
-    return layer.derived["bit_rows"]
+        layer.derived["bit_masks"] = (rows, cols, (rows != 0).astype(np.uint32) @ weights,
+                                      (cols != 0).astype(np.uint32) @ weights)
+    return layer.derived["bit_masks"]

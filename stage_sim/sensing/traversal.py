@@ -16,6 +16,16 @@ bits it looks at those cells only, in the walk's order (a hit, or the ray's own 
 The error term, the step count and the steps along each axis after a run are those of the step-by-step
 walk, so where the walk stops, and what it reports, are too.
 
+Runs through empty lines of a tile without robot cells are taken many at a time. Each tile keeps which of
+its rows and which of its columns hold a cell. When the rows ahead of an x-major walk are empty (or the
+columns ahead, every row to the tile's edge being then free), the walk takes the ``j`` whole runs that stay
+inside that empty band and inside the tile, in closed form: the run ending in the ``m``-th y-step ends after
+``ceil(((m − 1)·bx − e) / by)`` x-steps, ``e`` the error term before them, and the count of runs that end
+within ``L`` x-steps is ``floor((L·by + e) / bx) + 1`` (y-major walks: the same with the axes swapped). The
+error term, the position and the step count after them are those of the step-by-step walk, which never
+looked at a set cell there. On rooms.world's scans a ray walks 2.2 runs and 1.1 such bands instead of 11.4
+runs.
+
 Between regions, the jumps over empty regions follow Stage's floating-point crossings one by one (each
 crossing decides where the walk enters the next region holding a block). The step count they update,
 Stage's ``n = (int)(n - dist)``, is kept in a float between regions (``trunc``: the same integer, without a
@@ -66,13 +76,24 @@ def _first(bits, length, step):
     return length - 1 - high, bits ^ (np.uint64(1) << np.uint64(high))
 
 
+@numba.njit(inline="always", **_JIT)
+def _free_lines(used, first, step):
+    """How many lines (rows or columns) of a tile from line ``first`` on, towards ``step``, have no cell,
+    ``used`` holding a bit per line that has one."""
+    if step > 0:
+        ahead = used >> first
+        return REGION - first if ahead == 0 else np.int64(trailing_zeros(ahead))
+    behind = used & ((np.int64(2) << first) - 1)
+    return first + 1 if behind == 0 else first - (63 - np.int64(leading_zeros(behind)))
+
+
 @numba.njit(**_JIT)
 def _cast_range(world, robots, flags, place, origins, origin_of, heading, local, jitter, trig, rmax, ppm, owner,
                 out_at, out, cell, rid, a, b):
     """Rays a..b-1, ray i from point ``origins[origin_of[i]]`` at angle ``heading[origin_of[i]] + local[i]``
     (``+ jitter[out_at[i]]`` if given): range in metres (exactly ``rmax`` on a miss) into ``out[out_at[i]]``,
     flat cell hit (or -1) into ``cell[i]``, robot hit (or -1) into ``rid[i]``."""
-    static_rows, static_cols, tile_of_slot, slots = world
+    static_rows, static_cols, tile_of_slot, slots, rows_used, cols_used = world
     robot_regions, robot_ids, robot_rows, robot_cols = robots
     use_regions, use_robots = flags[0], flags[1]
     col0, row0, rcol0, rrow0, width = place[0], place[1], place[2], place[3], place[4]
@@ -131,14 +152,38 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
             if slot >= 0 or rtile != -1:
                 calculate_crossings = True
                 stile = tile_of_slot[slot] if slot >= 0 else -1  # -1: nothing static at this height here
+                row_used = np.int64(rows_used[stile]) if stile >= 0 else np.int64(0)
+                col_used = np.int64(cols_used[stile]) if stile >= 0 else np.int64(0)
                 rt = rtile if use_robots else -1  # < 0: no robot cell this layer sees here
                 cx0, cy0 = ix & (REGION - 1), iy & (REGION - 1)
                 cx, cy = cx0, cy0
                 found = False
                 n = np.int64(steps_left)
                 if xmajor:
-                    r = (by - 1 - exy) // by if by > 0 else _ENDLESS  # x-steps before the next y-step
+                    r = -1  # x-steps before the next y-step, worked out when first needed (a skip needs none)
                     while True:
+                        if rt < 0 and by > 0:  # whole runs through an empty band of rows, or of columns
+                            k = _free_lines(row_used, cy, sy)
+                            if k >= 2:  # k empty rows, to the tile's last column
+                                last = REGION - 1 - cx if sx > 0 else cx
+                            else:  # every row to the tile's edge, in the empty columns ahead
+                                k = REGION - cy if sy > 0 else cy + 1
+                                last = _free_lines(col_used, cx, sx) - 1
+                            room = by * last + exy  # x-steps allowed: up to ``last`` (runs are whole)
+                            if room >= 0:
+                                j = min(k, room // bx + 1)  # runs that fit
+                                along = ((j - 1) * bx - exy + by - 1) // by  # x-steps of those j runs
+                                if j >= 2 and along + j <= n:
+                                    cx += along * sx
+                                    cy += j * sy
+                                    exy += along * by - j * bx
+                                    n -= along + j
+                                    r = run_q + (1 if exy + bx < run_rem else 0)
+                                    if n <= 0 or cy < 0 or cy >= REGION:
+                                        break
+                                    continue
+                        if r < 0:
+                            r = (by - 1 - exy) // by if by > 0 else _ENDLESS
                         length = min(r + 1, n, REGION - cx if sx > 0 else cx + 1)  # cells to look at in row
                         mask = np.uint32(0)
                         if stile >= 0:
@@ -174,10 +219,30 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
                             n -= length
                             break
                 else:
-                    r = exy // bx + 1 if bx > 0 else _ENDLESS  # y-steps before the next x-step
-                    if exy < 0:
-                        r = 0
+                    r = -1  # y-steps before the next x-step, likewise
                     while True:
+                        if rt < 0 and bx > 0 and exy >= 0:  # likewise, columns or rows
+                            k = _free_lines(col_used, cx, sx)
+                            if k >= 2:
+                                last = REGION - 1 - cy if sy > 0 else cy
+                            else:
+                                k = REGION - cx if sx > 0 else cx + 1
+                                last = _free_lines(row_used, cy, sy) - 1
+                            room = bx * last - exy - 1
+                            if room >= 0:
+                                j = min(k, room // by + 1)
+                                along = (exy + (j - 1) * by) // bx + 1
+                                if j >= 2 and along + j <= n:
+                                    cy += along * sy
+                                    cx += j * sx
+                                    exy += j * by - along * bx
+                                    n -= along + j
+                                    r = run_q + (1 if exy - by + run_rem >= 0 else 0)
+                                    if n <= 0 or cx < 0 or cx >= REGION:
+                                        break
+                                    continue
+                        if r < 0:
+                            r = 0 if exy < 0 else (exy // bx + 1 if bx > 0 else _ENDLESS)
                         length = min(r + 1, n, REGION - cy if sy > 0 else cy + 1)
                         mask = np.uint32(0)
                         if stile >= 0:
@@ -222,12 +287,10 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
             else:
                 if calculate_crossings:
                     calculate_crossings = False
-                    regionx = float(int(ix / REGION) * REGION)
-                    regiony = float(int(iy / REGION) * REGION)
-                    if globx < 0 and ix % REGION != 0:
-                        regionx -= REGION
-                    if globy < 0 and iy % REGION != 0:
-                        regiony -= REGION
+                    # Stage's region corner, (int)(ix / REGION) * REGION less a region where globx < 0 and ix is
+                    # not a multiple: always the multiple of REGION at or below ix (ix = 0 when -1 < globx < 0)
+                    regionx = float(ix & -REGION)
+                    regiony = float(iy & -REGION)
                     xdx = regionx - globx - 1.0 if sx < 0 else regionx + REGION - globx
                     xdy = xdx * tana
                     ydy = regiony - globy - 1.0 if sy < 0 else regiony + REGION - globy

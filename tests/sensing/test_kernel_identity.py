@@ -95,6 +95,43 @@ def test_grazing_rays_along_walls_identical():
     assert_identical(numba_result, numpy_result)
 
 
+def scattered_segments(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    """A few short walls, 1-2 cells thick, along either axis, and lone cells: tiles with a wall in them are
+    mostly empty rows and columns, which the compiled walk crosses a band at a time."""
+    occ = np.zeros((h, w), dtype=bool)
+    for _ in range(rng.integers(3, 40)):
+        r, c, length, thick = rng.integers(0, h), rng.integers(0, w), rng.integers(1, 60), rng.integers(1, 3)
+        if rng.random() < 0.5:
+            occ[r : r + thick, c : c + length] = True
+        else:
+            occ[r : r + length, c : c + thick] = True
+    occ[rng.random((h, w)) < rng.uniform(0.0, 0.0005)] = True
+    return occ
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_rays_across_mostly_empty_tiles_identical(seed):
+    """Rays from anywhere (cell corners too), every direction (axes and multiples of 22.5° too), ending
+    anywhere (within a tile's empty band, on a wall, beyond): the band crossing changes no answer."""
+    rng = np.random.default_rng(100 + seed)
+    h, w = rng.integers(40, 300, 2)
+    occ = scattered_segments(rng, h, w)
+    blocks = occ | (rng.random((h, w)) < 0.0003)  # regions holding a block at another height only
+    n = 2000
+    xy = np.stack([rng.uniform(-0.3, w * RES + 0.3, n), rng.uniform(-0.3, h * RES + 0.3, n)], axis=1)
+    on_lines = rng.random(n) < 0.3
+    xy[on_lines] = np.round(xy[on_lines] / RES) * RES
+    xy += np.array(ORIGIN)
+    angles = rng.uniform(-math.pi, math.pi, n)
+    aligned = rng.random(n) < 0.2
+    angles[aligned] = rng.integers(-8, 8, aligned.sum()) * (math.pi / 8)
+    reach = rng.uniform(0.0, 8.0, n)
+    numpy_result = make_caster(occ, RES, ORIGIN, "numpy", blocks=blocks).cast(xy, angles, reach)
+    numba_result = make_caster(occ, RES, ORIGIN, "numba", blocks=blocks).cast(xy, angles, reach)
+    assert_identical(numba_result, numpy_result)
+    assert np.any(numpy_result.hit_cell >= 0) and np.any(numpy_result.hit_cell < 0)
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_crowds_of_touching_robots_identical(seed):
     rng = np.random.default_rng(10 + seed)
