@@ -8,7 +8,9 @@ path: memory in proportion to the robots' cells, 16-32 B each, never to the worl
 every body at the accepted poses are kept up to date through the rounds of refusals (only the refused
 robots' cells change) and handed to the lasers, which see the robots through the same cells. A clash
 that a round leaves must involve a robot that round moved back (the others share the cells they had), so
-the next round looks only at robots within touching distance of those. As in Stage,
+the next round looks only at robots within touching distance of those; the first round, only at robots
+within touching distance of another, and the compiled path sweeps only the bodies that a region holding
+a wall cell lies within reach of (neither narrowing changes a refusal). As in Stage,
 a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
 robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
 intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
@@ -115,6 +117,10 @@ class CollisionChecker:
         self._robots_can_clash = int(np.count_nonzero(collides)) > 1
         self._in_layer = [layer_of_robot == i for i in range(len(layers))]  # per layer: its robots (N,)
         counts = np.bincount(bodies.owner, minlength=bodies.count)
+        # per slot of the tile grid: whether some collision layer has cells there (1 B a slot)
+        self._blocking = np.zeros(layers[0].grid.slot_count if layers else 0, dtype=bool)
+        for layer in layers:
+            self._blocking |= layer.tile_of_slot >= 0
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self._colliding = np.flatnonzero(collides)
@@ -136,7 +142,8 @@ class CollisionChecker:
         refused = np.zeros(len(poses), dtype=bool)
         movers = np.flatnonzero(moving & self._collides)
         if self.grid.kernels == "numba":
-            candidates = self._compiled_moves(poses, velocities, dt, moving, movers, refused)
+            candidates = self._compiled_moves(poses, velocities, dt, moving, self._near_static(poses, velocities, dt,
+                                                                                             movers), refused)
         else:
             candidates = poses.copy()
             candidates[moving] = integrate(poses[moving], velocities[moving], dt)
@@ -146,7 +153,7 @@ class CollisionChecker:
         cells = self.bodies.point_cells(final, self.grid)
         if not self._robots_can_clash:
             return final, refused, cells
-        among = self._colliding
+        among = self._crowded(final)
         for _ in range(MAX_CONFLICT_ROUNDS):
             conflict = self._clashes(cells, among) & moving & ~refused
             if not conflict.any():
@@ -253,6 +260,43 @@ class CollisionChecker:
             return
         point_index, entry = self._points_of(robots)
         cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
+
+    def _near_static(self, poses: np.ndarray, velocities: np.ndarray, dt: float, movers: np.ndarray) -> np.ndarray:
+        """The movers whose body could meet a static cell on this move: a region holding a collision layer's
+        cell lies within their radius, their step and two cells (the compiled path tests only these; a body
+        far from every wall cannot be refused by one, so the numpy reference, which tests every mover, gives
+        the same refusals: ``tests/sim/test_wall_broad_phase.py``)."""
+        if not movers.size or not self._layers:
+            return movers
+        from stage_sim.sim.collision_kernels import near_static
+
+        grid = self._layers[0].grid
+        reach = (self.bodies.radius[movers] + np.hypot(velocities[movers, 0], velocities[movers, 1]) * dt
+                 + 2 * self.grid.resolution)
+        near = np.empty(movers.size, dtype=bool)
+        near_static(movers, poses[:, 0].copy(), poses[:, 1].copy(), reach, self.grid.resolution, *self.grid.origin_xy,
+                    grid.slots, self._blocking, grid.place, near)
+        return movers[near]
+
+    def _crowded(self, poses: np.ndarray) -> np.ndarray:
+        """The colliding robots within touching distance of another at ``poses`` (centres no farther apart than
+        their radii and two cells): only these can share a cell, so the first clash test looks at these alone;
+        every colliding robot when there are more than :data:`NARROWING_PAIRS` pairs to measure."""
+        robots = self._colliding
+        if robots.size * (robots.size - 1) // 2 > NARROWING_PAIRS:
+            return robots
+        margin = 2 * self.grid.resolution
+        if self.grid.kernels == "numba":
+            from stage_sim.sim.collision_kernels import crowded
+
+            close = np.zeros(robots.size, dtype=bool)
+            crowded(robots, poses, self.bodies.radius, margin, close)
+            return robots[close]
+        gap = poses[robots, None, :2] - poses[None, robots, :2]
+        reach = self.bodies.radius[robots, None] + self.bodies.radius[None, robots] + margin
+        close = np.hypot(gap[..., 0], gap[..., 1]) <= reach
+        np.fill_diagonal(close, False)
+        return robots[close.any(axis=1)]
 
     def _near(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """The colliding robots whose bodies at ``poses`` could share a cell with one of ``robots``' (centres no
