@@ -64,6 +64,7 @@ bench: setup
 	$(PY) benchmarks/stageros.py
 	$(PY) benchmarks/startup.py
 	taskset -c 0 $(PY) benchmarks/worlds.py
+	taskset -c 0 $(PY) benchmarks/jump_chain.py
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts
