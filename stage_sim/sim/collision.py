@@ -9,8 +9,8 @@ every body at the accepted poses are kept up to date through the rounds of refus
 robots' cells change) and handed to the lasers, which see the robots through the same cells. A clash
 that a round leaves must involve a robot that round moved back (the others share the cells they had), so
 the next round looks only at robots within touching distance of those; the first round, only at robots
-within touching distance of another, and the compiled path sweeps only the bodies that a region holding
-a wall cell lies within reach of (neither narrowing changes a refusal). As in Stage,
+within touching distance of another, and the compiled sweep looks at a body's points only where a region
+holding a wall cell lies within its radius (neither narrowing changes a refusal). As in Stage,
 a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
 robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
 intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
@@ -117,10 +117,6 @@ class CollisionChecker:
         self._robots_can_clash = int(np.count_nonzero(collides)) > 1
         self._in_layer = [layer_of_robot == i for i in range(len(layers))]  # per layer: its robots (N,)
         counts = np.bincount(bodies.owner, minlength=bodies.count)
-        # per slot of the tile grid: whether some collision layer has cells there (1 B a slot)
-        self._blocking = np.zeros(layers[0].grid.slot_count if layers else 0, dtype=bool)
-        for layer in layers:
-            self._blocking |= layer.tile_of_slot >= 0
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self._colliding = np.flatnonzero(collides)
@@ -142,8 +138,7 @@ class CollisionChecker:
         refused = np.zeros(len(poses), dtype=bool)
         movers = np.flatnonzero(moving & self._collides)
         if self.grid.kernels == "numba":
-            candidates = self._compiled_moves(poses, velocities, dt, moving, self._near_static(poses, velocities, dt,
-                                                                                             movers), refused)
+            candidates = self._compiled_moves(poses, velocities, dt, moving, movers, refused)
         else:
             candidates = poses.copy()
             candidates[moving] = integrate(poses[moving], velocities[moving], dt)
@@ -240,8 +235,8 @@ class CollisionChecker:
             grid = layer.grid
             self.grid.compiled(sweep_kernels, "static_hits", len(x))(
                 self.bodies.points, self._point_start, self._point_count, x, y, cos_p, sin_p, robot,
-                self._in_layer[i], self.grid.resolution, *self.grid.origin_xy, *self.grid.shape, grid.slots,
-                grid.place, layer.tile_of_slot, layer.bits, hit)
+                self._in_layer[i], self.bodies.radius, self.grid.resolution, *self.grid.origin_xy, *self.grid.shape,
+                grid.slots, grid.place, layer.tile_of_slot, layer.bits, hit)
         refused[movers] = hit[movers]
         return candidates
 
@@ -260,23 +255,6 @@ class CollisionChecker:
             return
         point_index, entry = self._points_of(robots)
         cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
-
-    def _near_static(self, poses: np.ndarray, velocities: np.ndarray, dt: float, movers: np.ndarray) -> np.ndarray:
-        """The movers whose body could meet a static cell on this move: a region holding a collision layer's
-        cell lies within their radius, their step and two cells (the compiled path tests only these; a body
-        far from every wall cannot be refused by one, so the numpy reference, which tests every mover, gives
-        the same refusals: ``tests/sim/test_wall_broad_phase.py``)."""
-        if not movers.size or not self._layers:
-            return movers
-        from stage_sim.sim.collision_kernels import near_static
-
-        grid = self._layers[0].grid
-        reach = (self.bodies.radius[movers] + np.hypot(velocities[movers, 0], velocities[movers, 1]) * dt
-                 + 2 * self.grid.resolution)
-        near = np.empty(movers.size, dtype=bool)
-        near_static(movers, poses[:, 0].copy(), poses[:, 1].copy(), reach, self.grid.resolution, *self.grid.origin_xy,
-                    grid.slots, self._blocking, grid.place, near)
-        return movers[near]
 
     def _crowded(self, poses: np.ndarray) -> np.ndarray:
         """The colliding robots within touching distance of another at ``poses`` (centres no farther apart than

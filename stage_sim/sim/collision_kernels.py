@@ -160,30 +160,6 @@ def crowded(robots, poses, radius, margin, out):
 
 
 @numba.njit(**_JIT)
-def near_static(movers, x, y, reach, resolution, ox, oy, slots, blocking, place, out):
-    """``out[k]``: whether a region within ``reach[k]`` metres (a square around (x, y) of mover
-    ``movers[k]``) holds a cell of a collision layer (``blocking``: per slot of ``slots``, whether one has
-    a tile there; ``place``: col0, row0, rcol0, rrow0 of the tile grid, whose cell (0, 0) is at (ox, oy))."""
-    col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
-    rh, rw = slots.shape
-    for k in range(movers.size):
-        r = movers[k]
-        out[k] = False
-        c_lo = max(0, ((math.floor((x[r] - reach[k] - ox) / resolution) + col0) >> TILE_BITS) - rcol0)
-        c_hi = min(rw - 1, ((math.floor((x[r] + reach[k] - ox) / resolution) + col0) >> TILE_BITS) - rcol0)
-        r_lo = max(0, ((math.floor((y[r] - reach[k] - oy) / resolution) + row0) >> TILE_BITS) - rrow0)
-        r_hi = min(rh - 1, ((math.floor((y[r] + reach[k] - oy) / resolution) + row0) >> TILE_BITS) - rrow0)
-        for rr in range(r_lo, r_hi + 1):
-            for rc in range(c_lo, c_hi + 1):
-                slot = slots[rr, rc]
-                if slot >= 0 and blocking[slot]:
-                    out[k] = True
-                    break
-            if out[k]:
-                break
-
-
-@numba.njit(**_JIT)
 def layer_contains(cells, slots, tile_of_slot, bits, place, width, out):
     """``out[i]``: whether flat cell ``cells[i]`` (-1: off the grid) is in a
     :class:`~stage_sim.maps.tiles.TileLayer` (its slots, tiles and bits; ``place``: col0, row0, rcol0,

@@ -56,14 +56,35 @@ def probe_poses(poses, velocities, dt, movers, speed, radius, min_width, resolut
 
 
 @numba.njit(inline="always", **_JIT)
-def _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, resolution, ox, oy, height, width,
-                 slots, place, tile_of_slot, bits, hit, a, b):
+def near_layer(x, y, reach, resolution, ox, oy, slots, place, tile_of_slot):
+    """Whether a region within ``reach`` metres of (x, y) (a square around it) holds a cell of the tile layer
+    (``slots``, ``place``: its grid, whose cell (0, 0) is at (ox, oy); ``tile_of_slot``: the layer's tiles).
+    A body farther than its radius from every such region has no point on one of the layer's cells."""
+    col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
+    rh, rw = slots.shape
+    c_lo = max(0, ((math.floor((x - reach - ox) / resolution) + col0) >> TILE_BITS) - rcol0)
+    c_hi = min(rw - 1, ((math.floor((x + reach - ox) / resolution) + col0) >> TILE_BITS) - rcol0)
+    r_lo = max(0, ((math.floor((y - reach - oy) / resolution) + row0) >> TILE_BITS) - rrow0)
+    r_hi = min(rh - 1, ((math.floor((y + reach - oy) / resolution) + row0) >> TILE_BITS) - rrow0)
+    for rr in range(r_lo, r_hi + 1):
+        for rc in range(c_lo, c_hi + 1):
+            slot = slots[rr, rc]
+            if slot >= 0 and tile_of_slot[slot] >= 0:
+                return True
+    return False
+
+
+@numba.njit(inline="always", **_JIT)
+def _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, radius, resolution, ox, oy, height,
+                 width, slots, place, tile_of_slot, bits, hit, a, b):
     col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
     rh, rw = slots.shape
     for k in range(a, b):
         r = robot[k]
         if hit[r] or not use[r]:
             continue
+        if not near_layer(x[k], y[k], radius[r] + 2 * resolution, resolution, ox, oy, slots, place, tile_of_slot):
+            continue  # no point of this probe can fall on a cell of the layer: the reference finds none either
         for i in range(point_start[r], point_start[r] + point_count[r]):
             row, col = point_row_col(x[k], y[k], cos[k], sin[k], points[i, 0], points[i, 1], resolution, ox, oy)
             if not (0 <= col < width and 0 <= row < height):
@@ -85,22 +106,23 @@ def _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, r
 
 
 @numba.njit(**_JIT)
-def static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, resolution, ox, oy, height, width,
-                slots, place, tile_of_slot, bits, hit):
+def static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, radius, resolution, ox, oy, height,
+                width, slots, place, tile_of_slot, bits, hit):
     """Set ``hit[r]`` for every robot ``r`` whose outline, at one of its probes, falls on a cell of the tile
     layer (``slots``, ``place``: its :class:`~stage_sim.maps.tiles.TileGrid`; ``tile_of_slot``, ``bits``: the
-    :class:`~stage_sim.maps.tiles.TileLayer`). Probes of robots with ``use[r]`` false are skipped."""
-    _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, resolution, ox, oy, height, width,
-                 slots, place, tile_of_slot, bits, hit, 0, x.size)
+    :class:`~stage_sim.maps.tiles.TileLayer`). Probes of robots with ``use[r]`` false are skipped, and so are
+    the points of a probe with no region holding a layer cell within the robot's ``radius`` (:func:`near_layer`)."""
+    _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, radius, resolution, ox, oy, height,
+                 width, slots, place, tile_of_slot, bits, hit, 0, x.size)
 
 
 @numba.njit(parallel=True, **_JIT)
-def static_hits_parallel(points, point_start, point_count, x, y, cos, sin, robot, use, resolution, ox, oy, height,
-                         width, slots, place, tile_of_slot, bits, hit):
+def static_hits_parallel(points, point_start, point_count, x, y, cos, sin, robot, use, radius, resolution, ox, oy,
+                         height, width, slots, place, tile_of_slot, bits, hit):
     """:func:`static_hits`, groups of probes on numba's threads (a robot's flag only ever turns True, so the
     order in which its probes are tested changes no answer)."""
     n = x.size
     step = 16
     for k in numba.prange((n + step - 1) // step):
-        _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, resolution, ox, oy, height,
-                     width, slots, place, tile_of_slot, bits, hit, k * step, min(n, (k + 1) * step))
+        _static_hits(points, point_start, point_count, x, y, cos, sin, robot, use, radius, resolution, ox, oy,
+                     height, width, slots, place, tile_of_slot, bits, hit, k * step, min(n, (k + 1) * step))
