@@ -1,12 +1,12 @@
 """Floor of Stage's jumps over empty regions: the chain of one jump after another, alone, compiled.
 
 Run with the venv's python: ``taskset -c 0 .venv/bin/python benchmarks/jump_chain.py``. Prints one JSON line
-per beam slope: ns per jump of Stage's jump (the nearer crossing taken, both crossings and distances
-advanced, the step count truncated: :mod:`stage_sim.sensing.traversal`'s arithmetic) with no region looked
-up, and of the same without the step count, in a loop that does nothing else. Every jump depends on the
-one before, so this is what each of the ~95 jumps of a beam of the 1 mm RL world (``worlds.py``) costs at
-the least, whatever the region lookups around it cost: ``rl_world_jumps_ms`` is that floor for one step
-of that world (102,400 beams).
+per beam slope: ns per jump of Stage's jump (the nearer crossing taken, both crossings and distances advanced,
+the step count truncated: :mod:`stage_sim.sensing.traversal`'s arithmetic) with no region looked up, and of
+the same without the step count, in a loop that does nothing else (the walk's own
+:func:`~stage_sim.sensing.traversal.stage_jump`). Every jump depends on the one before, so this is what each
+of the ~95 jumps of a beam of the 1 mm RL world (``worlds.py``) costs at the least, whatever the region
+lookups around it cost: ``rl_world_jumps_ms`` is that floor for one step of that world (102,400 beams).
 """
 
 from __future__ import annotations
@@ -16,6 +16,8 @@ import time
 
 import numba
 import numpy as np
+
+from stage_sim.sensing.traversal import stage_jump
 
 JUMPS = 20_000_000
 RL_BEAMS = 102_400
@@ -34,20 +36,10 @@ def jumps(count: int, tana: float, step_count: bool) -> float:
     steps_left = 1e15
     total = 0.0
     for _ in range(count):
-        takex = dist_x < dist_y
-        basex = xcrossx if takex else ycrossx
-        basey = xcrossy if takex else ycrossy
+        basex, basey, jumped, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y = stage_jump(
+            xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjumpy, yjumpx, yjumpy, xjumpdist, yjumpdist)
         if step_count:
-            steps_left = np.trunc(steps_left - (dist_x if takex else dist_y))
-        next_xx, next_xy = xcrossx + xjumpx, xcrossy + xjumpy
-        next_yx, next_yy = ycrossx + yjumpx, ycrossy + yjumpy
-        left_y, left_x = dist_y - dist_x, dist_x - dist_y
-        xcrossx = next_xx if takex else xcrossx
-        xcrossy = next_xy if takex else xcrossy
-        ycrossx = ycrossx if takex else next_yx
-        ycrossy = ycrossy if takex else next_yy
-        dist_y = left_y if takex else yjumpdist
-        dist_x = xjumpdist if takex else left_x
+            steps_left = np.trunc(steps_left - jumped)
         total += basex + basey
         if not steps_left > 0:
             break
