@@ -263,16 +263,13 @@ class CollisionChecker:
         robots = self._colliding
         if robots.size * (robots.size - 1) // 2 > NARROWING_PAIRS:
             return robots
-        margin = 2 * self.grid.resolution
         if self.grid.kernels == "numba":
             from stage_sim.sim.collision_kernels import crowded
 
             close = np.zeros(robots.size, dtype=bool)
-            crowded(robots, poses, self.bodies.radius, margin, close)
+            crowded(robots, poses, self.bodies.radius, 2 * self.grid.resolution, close)
             return robots[close]
-        gap = poses[robots, None, :2] - poses[None, robots, :2]
-        reach = self.bodies.radius[robots, None] + self.bodies.radius[None, robots] + margin
-        close = np.hypot(gap[..., 0], gap[..., 1]) <= reach
+        close = self._touching(robots, robots, poses)
         np.fill_diagonal(close, False)
         return robots[close.any(axis=1)]
 
@@ -288,10 +285,14 @@ class CollisionChecker:
             kernel = self.grid.compiled(collision_kernels, "near_robots", robots.size * self._colliding.size)
             kernel(self._colliding, robots, poses, self.bodies.radius, 2 * self.grid.resolution, near)
             return self._colliding[near]
-        others = self._colliding
+        return self._colliding[self._touching(self._colliding, robots, poses).any(axis=1)]
+
+    def _touching(self, others: np.ndarray, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """(others, robots) pairs whose centres at ``poses`` are no farther apart than their radii and two cells
+        (the numpy path's distance matrix; the compiled one loops over the pairs)."""
         gap = poses[others, None, :2] - poses[None, robots, :2]
         reach = self.bodies.radius[others, None] + self.bodies.radius[None, robots] + 2 * self.grid.resolution
-        return others[np.any(np.hypot(gap[..., 0], gap[..., 1]) <= reach, axis=1)]
+        return np.hypot(gap[..., 0], gap[..., 1]) <= reach
 
     def _clashes(self, cells: np.ndarray, among: np.ndarray) -> np.ndarray:
         """Robots of ``among`` (colliding robots) whose body points (``cells``, per body point) share a cell
