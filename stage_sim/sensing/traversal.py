@@ -95,6 +95,12 @@ def stage_jump(xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjump
 
 
 @numba.njit(inline="always", **_JIT)
+def _quot(a, b):
+    """``a // b`` for ``a >= 0``, ``b > 0``: an unsigned division, without the sign fix-ups of floor division."""
+    return np.int64(np.uint64(a) // np.uint64(b))
+
+
+@numba.njit(inline="always", **_JIT)
 def _free_lines(used, first, step):
     """How many lines (rows or columns) of a tile from line ``first`` on, towards ``step``, have no cell,
     ``used`` holding a bit per line that has one."""
@@ -146,9 +152,11 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
         xmajor = ax > ay
         run_q = run_rem = 0  # every run after the first is run_q or run_q + 1 steps
         if xmajor and by > 0:
-            run_q, run_rem = bx // by, bx % by
+            run_q = _quot(bx, by)
+            run_rem = bx - run_q * by
         elif not xmajor and bx > 0:
-            run_q, run_rem = by // bx, by % bx
+            run_q = _quot(by, bx)
+            run_rem = by - run_q * bx
         xjumpx, xjumpy = float(sx * REGION), (sx * REGION) * tana
         yjumpx, yjumpy = (sy * REGION) / tana, float(sy * REGION)
         xjumpdist = abs(xjumpx) + abs(xjumpy)
@@ -189,8 +197,8 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
                                 last = _free_lines(col_used, cx, sx) - 1
                             room = by * last + exy  # x-steps allowed: up to ``last`` (runs are whole)
                             if room >= 0:
-                                j = min(k, room // bx + 1)  # runs that fit
-                                along = ((j - 1) * bx - exy + by - 1) // by  # x-steps of those j runs
+                                j = min(k, _quot(room, bx) + 1)  # runs that fit
+                                along = _quot((j - 1) * bx - exy + by - 1, by)  # x-steps of those j runs
                                 if j >= 2 and along + j <= n:
                                     cx += along * sx
                                     cy += j * sy
@@ -201,7 +209,7 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
                                         break
                                     continue
                         if r < 0:
-                            r = (by - 1 - exy) // by if by > 0 else _ENDLESS
+                            r = _quot(by - 1 - exy, by) if by > 0 else _ENDLESS
                         length = min(r + 1, n, REGION - cx if sx > 0 else cx + 1)  # cells to look at in row
                         mask = np.uint32(0)
                         if stile >= 0:
@@ -248,8 +256,8 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
                                 last = _free_lines(row_used, cy, sy) - 1
                             room = bx * last - exy - 1
                             if room >= 0:
-                                j = min(k, room // by + 1)
-                                along = (exy + (j - 1) * by) // bx + 1
+                                j = min(k, _quot(room, by) + 1)
+                                along = _quot(exy + (j - 1) * by, bx) + 1
                                 if j >= 2 and along + j <= n:
                                     cy += along * sy
                                     cx += j * sx
@@ -260,7 +268,7 @@ def _cast_range(world, robots, flags, place, origins, origin_of, heading, local,
                                         break
                                     continue
                         if r < 0:
-                            r = 0 if exy < 0 else (exy // bx + 1 if bx > 0 else _ENDLESS)
+                            r = 0 if exy < 0 else (_quot(exy, bx) + 1 if bx > 0 else _ENDLESS)
                         length = min(r + 1, n, REGION - cy if sy > 0 else cy + 1)
                         mask = np.uint32(0)
                         if stile >= 0:
