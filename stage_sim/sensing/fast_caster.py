@@ -46,7 +46,8 @@ class NumbaRayCaster:
         self._world = (rows, cols, layer.tile_of_slot, layer.grid.slots, rows_used, cols_used)
         self._place = np.append(layer.grid.place, self.width)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
-                           np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32))
+                           np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32),
+                           np.zeros(1, dtype=np.uint32), np.zeros(1, dtype=np.uint32), np.full(1, -1, dtype=np.int32))
 
     def robot_layer(self) -> RobotLayer:
         """An empty robot layer for this caster's grid."""
@@ -82,7 +83,8 @@ class NumbaRayCaster:
         indices, float64 values, C-contiguous."""
         n = owners.size
         layer = (self._no_robots if robots is None else
-                 (robots.regions, robots.ids, robots.rows, robots.cols))
+                 (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
+                  robots.owner))
         flags = (robots is not None, robots is not None and robots.active)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)

@@ -58,11 +58,16 @@ def number_robot_regions(regions, old, cells, ids, visible, place, width, marked
 
 
 @numba.njit(**_JIT)
-def write_robot_tiles(cell_ids, rows, cols, tile, local, ids, count, several):
+def write_robot_tiles(cell_ids, rows, cols, rows_used, cols_used, owner, tile, local, ids, count, several):
     """Clear the masks of tiles 0…count-1, then write robot ``ids[i]`` into its cell (``several`` where two
-    robots meet) and its bit into the row and column masks; returns whether any cell was written."""
+    robots meet), its bit into the row and column masks, its row and column into the tile's ``rows_used``
+    and ``cols_used`` masks, and its id into ``owner`` (``several`` once a tile holds two robots' cells);
+    returns whether any cell was written."""
     rows[:count] = 0
     cols[:count] = 0
+    rows_used[:count] = 0
+    cols_used[:count] = 0
+    owner[:count] = -1
     written = False
     for i in range(tile.size):
         t = tile[i]
@@ -76,6 +81,11 @@ def write_robot_tiles(cell_ids, rows, cols, tile, local, ids, count, several):
             cell_ids[t, y, x] = robot
             rows[t, y] |= bit
             cols[t, x] |= np.uint32(1) << np.uint32(y)
-        elif cell_ids[t, y, x] != robot:
+            rows_used[t] |= np.uint32(1) << np.uint32(y)
+            cols_used[t] |= bit
+            if owner[t] != robot:
+                owner[t] = robot if owner[t] == -1 else several
+        elif cell_ids[t, y, x] != robot:  # (the cell's first robot is the tile's, or it has several)
             cell_ids[t, y, x] = several
+            owner[t] = several
     return written

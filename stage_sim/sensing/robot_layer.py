@@ -9,11 +9,14 @@ let the walk cross robot-free space in one go, each caster gets what it reads be
   (-1 none, :data:`SEVERAL_ROBOTS` two or more), and per block and quadrant the largest square of robot-free
   blocks ahead of it within the tile (:func:`~stage_sim.sensing.distance_field.tile_square_fields`);
 * the compiled caster: a 32-bit mask of the robot cells of every row and every column of a tile
-  (:mod:`stage_sim.sensing.traversal` tests a whole run of its walk against one).
+  (:mod:`stage_sim.sensing.traversal` tests a whole run of its walk against one), per tile a mask of the
+  rows and one of the columns holding a robot cell (the walk crosses the others many runs at a time), and
+  the tile's one robot (:data:`SEVERAL_ROBOTS` if more): a ray of that robot walks the tile as if empty of
+  robots, as a robot's own cells never stop its rays (a ray leaves its robot's body through such tiles).
 
 What it costs: the region index, int32 per region (4 B per 1024 cells of the world's bounding box); per
-tile in use 4 KB of ids (int32 per cell) and 128 B of block owners and squares (numpy) or 256 B of masks
-(compiled). Each update touches only the cells the robots cover (O(robot cells), no sort).
+tile in use 4 KB of ids (int32 per cell) and 128 B of block owners and squares (numpy) or 268 B of masks
+and owner (compiled). Each update touches only the cells the robots cover (O(robot cells), no sort).
 """
 
 from __future__ import annotations
@@ -77,6 +80,9 @@ class RobotLayer:
         self.block_squares = np.zeros((0, 4, TILE_BLOCKS, TILE_BLOCKS), dtype=np.uint8)
         self.rows = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each row (compiled)
         self.cols = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each column (compiled)
+        self.rows_used = np.zeros(0, dtype=np.uint32)  #: (T,) rows of a tile holding a robot cell (compiled)
+        self.cols_used = np.zeros(0, dtype=np.uint32)  #: (T,) columns of a tile holding one (compiled)
+        self.owner = np.zeros(0, dtype=np.int32)  #: (T,) the tile's one robot, or SEVERAL_ROBOTS (compiled)
         self._marked = np.empty(0, dtype=np.int64)
         self.active = False
 
@@ -127,8 +133,9 @@ class RobotLayer:
             self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
             self.shape[1], MARKED)
         self._reserve(count)
-        self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, tile, local,
-                                                      ids.astype(np.int32), count, SEVERAL_ROBOTS)
+        self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
+                                                      self.owner, tile, local, ids.astype(np.int32), count,
+                                                      SEVERAL_ROBOTS)
 
     def _flat(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> np.ndarray:
         """Flat grid cells of (row, col) pairs, −1 for those off the grid."""
@@ -153,6 +160,9 @@ class RobotLayer:
             if self.compiled:
                 self.rows = np.empty((capacity, TILE), dtype=np.uint32)
                 self.cols = np.empty((capacity, TILE), dtype=np.uint32)
+                self.rows_used = np.empty(capacity, dtype=np.uint32)
+                self.cols_used = np.empty(capacity, dtype=np.uint32)
+                self.owner = np.empty(capacity, dtype=np.int32)
             else:
                 self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
 

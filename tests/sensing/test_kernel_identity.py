@@ -154,6 +154,52 @@ def test_crowds_of_touching_robots_identical(seed):
     assert np.any(results[0].hit_robot >= 0) and np.any(results[0].hit_robot == SEVERAL_ROBOTS)
 
 
+def ring_bodies(rng: np.random.Generator, occ: np.ndarray, robots: int):
+    """Round robots 40-140 cells across, as Stage rasterises bitmap bodies drawn at a fine resolution: the
+    outline and chords across the inside, so a body spans several tiles and its scans leave it through tiles
+    holding its own cells only; about a third overlap the robot placed before them (tiles of two robots)."""
+    h, w = occ.shape
+    rows, cols, ids, centres = [], [], [], []
+    for i in range(robots):
+        radius = rng.integers(20, 70)
+        near = centres and rng.random() < 0.35
+        centre = centres[-1] + rng.normal(0, radius, 2) if near else rng.uniform(0, [h, w])
+        rr, cc = np.mgrid[int(centre[0]) - radius - 1 : int(centre[0]) + radius + 2,
+                          int(centre[1]) - radius - 1 : int(centre[1]) + radius + 2]
+        d = np.hypot(rr + 0.5 - centre[0], cc + 0.5 - centre[1])
+        body = ((d <= radius) & (d > radius - 1.5)) | ((d < radius) & (rr % 9 == 0))
+        rows.append(rr[body])
+        cols.append(cc[body])
+        ids.append(np.full(int(body.sum()), i))
+        centres.append(centre)
+    return tuple(np.concatenate(a) for a in (rows, cols, ids)), np.array(centres)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_rays_leaving_their_own_robots_body_identical(seed):
+    rng = np.random.default_rng(40 + seed)
+    occ = office(rng, 330, 400)
+    (rows, cols, ids), centres = ring_bodies(rng, occ, 12)
+    beams = 180
+    xy_own = np.repeat(centres[:, ::-1] * RES + np.array(ORIGIN), beams, axis=0)
+    heading = rng.uniform(-math.pi, math.pi, 12)
+    heading[::3] = 0.0  # axis-aligned beams among them
+    angles_own = (heading[:, None] + np.linspace(-math.pi, math.pi, beams)[None, :]).ravel()
+    xy_any, angles_any, reach_any = rays(rng, occ, 20, beams)
+    xy = np.concatenate([xy_own, xy_any])
+    angles = np.concatenate([angles_own, angles_any])
+    reach = np.concatenate([np.full(xy_own.shape[0], 5.6), reach_any])
+    owners = np.concatenate([np.repeat(np.arange(12), beams), np.repeat(rng.integers(-1, 12, 20), beams)])
+    results = []
+    for kernels in ("numpy", "numba"):
+        caster = make_caster(occ, RES, ORIGIN, kernels)
+        layer = caster.robot_layer()
+        layer.update(rows, cols, ids)
+        results.append(caster.cast(xy, angles, reach, owners=owners, robots=layer))
+    assert_identical(results[1], results[0])
+    assert np.any(results[0].hit_robot >= 0) and np.any((results[0].hit_robot == -1) & (results[0].hit_cell >= 0))
+
+
 def test_threads_do_not_change_answers():
     rng = np.random.default_rng(21)
     occ = office(rng)
