@@ -36,6 +36,9 @@ def number_robot_regions(regions, old, cells, ids, visible, place, width, marked
         cell = cells[i]
         if cell < 0:
             continue
+        if i > 0 and cell == cells[i - 1] and ids[i] == ids[i - 1]:  # the point before's cell (outlines are
+            tile[i], local[i] = tile[i - 1], local[i - 1]  # sampled at half a cell): nothing new to mark
+            continue
         r = np.int64(cell * per_width)  # cell // width without an integer division, corrected to be exact
         if r * width > cell:
             r -= 1
@@ -74,6 +77,8 @@ def write_robot_tiles(cell_ids, rows, cols, rows_used, cols_used, owner, tile, l
         if t < 0:
             continue
         written = True
+        if i > 0 and t == tile[i - 1] and local[i] == local[i - 1] and ids[i] == ids[i - 1]:
+            continue  # the point before's cell, written already
         robot = ids[i]
         y, x = local[i] >> TILE_BITS, local[i] & (TILE - 1)
         bit = np.uint32(1) << np.uint32(x)
