@@ -1,8 +1,9 @@
 """Compiled (numba) update of a :class:`~stage_sim.sensing.robot_layer.RobotLayer`: the numpy update's result,
 in one pass over the robots' cells (no temporaries the size of the cells but the per-cell tile numbers).
 
-Only the row and column masks are cleared each step (256 B a tile): a cell's id is read only where its mask
-bit is set, so the ids (4 KB a tile, tens of MB for robots drawn at 1 mm) are written, never wiped."""
+Only the row and column masks, the used-line masks and the owner are cleared each step (268 B a tile): a
+cell's id is read only where its mask bit is set, so the ids (4 KB a tile, tens of MB for robots drawn at
+1 mm) are written, never wiped."""
 
 from __future__ import annotations
 
