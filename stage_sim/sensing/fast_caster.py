@@ -6,7 +6,8 @@ the rest of Stage's per-ray constants (:class:`~stage_sim.sensing.stage_walk.Wal
 
 Memory: the static layer's bit rows and columns, 264 B per tile (only the world's regions holding a cell at
 this height: :mod:`stage_sim.maps.tiles`), the tile grid's region index (4 B per region) shared with the
-world, and the robot layer (:class:`~stage_sim.sensing.robot_layer.RobotLayer`).
+world, the stop map (1 B per region and its margin, :mod:`stage_sim.sensing.stop_map`) and the robot layer
+(:class:`~stage_sim.sensing.robot_layer.RobotLayer`).
 """
 
 from __future__ import annotations
@@ -19,8 +20,10 @@ from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sensing.stage_walk import ray_arguments, static_layer
+from stage_sim.sensing.stop_map import StopMap
 
 _NONE = np.zeros(0)  # an absent jitter or trigonometry cache
+_NO_REGIONS = np.zeros(0, dtype=np.int64)  # no robot layer's regions
 
 
 class NumbaRayCaster:
@@ -45,6 +48,7 @@ class NumbaRayCaster:
         rows, cols, rows_used, cols_used = bit_masks(layer)
         self._world = (rows, cols, layer.tile_of_slot, layer.grid.slots, rows_used, cols_used)
         self._place = np.append(layer.grid.place, self.width)
+        self._stops = StopMap(layer.grid.slots)
         self._no_robots = (np.full((1, 1), -1, dtype=np.int32), np.full((1, 1, 1), -1, dtype=np.int32),
                            np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32),
                            np.zeros(1, dtype=np.uint32), np.zeros(1, dtype=np.uint32), np.full(1, -1, dtype=np.int32))
@@ -86,10 +90,12 @@ class NumbaRayCaster:
                  (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
                   robots.owner))
         flags = (robots is not None, robots is not None and robots.active)
+        marked = _NO_REGIONS if robots is None else robots.marked
+        stops, pad = self._stops.fitted(float(rmax.max(initial=0.0)) / self.resolution)
         cell = np.empty(n, dtype=np.int64)
         hit_robot = np.empty(n, dtype=np.int32)
-        args = (self._world, layer, flags, self._place, origins, origin_of, heading, local, jitter, trig, rmax,
-                1.0 / self.resolution, owners, out_at, out, cell, hit_robot)
+        args = (self._world, layer, flags, self._place, stops, pad, marked, origins, origin_of, heading, local, jitter,
+                trig, rmax, 1.0 / self.resolution, owners, out_at, out, cell, hit_robot)
         if self.threads > 1 and n > 1024:
             set_threads(self.threads)
             traversal.cast_parallel(*args)

@@ -86,6 +86,11 @@ class RobotLayer:
         self._marked = np.empty(0, dtype=np.int64)
         self.active = False
 
+    @property
+    def marked(self) -> np.ndarray:
+        """The regions holding robot cells (flat in the region grid): where :attr:`regions` is not -1."""
+        return self._marked
+
     def update(
         self,
         cell_rows: np.ndarray,

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from stage_sim.sensing import stop_map
 from stage_sim.sensing.casters import make_caster
 from stage_sim.sensing.distance_field import tile_square_fields
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
@@ -198,6 +199,64 @@ def test_rays_leaving_their_own_robots_body_identical(seed):
         results.append(caster.cast(xy, angles, reach, owners=owners, robots=layer))
     assert_identical(results[1], results[0])
     assert np.any(results[0].hit_robot >= 0) and np.any((results[0].hit_robot == -1) & (results[0].hit_cell >= 0))
+
+
+@pytest.mark.parametrize("margin", ["wide", "capped", "none"])
+def test_rays_beyond_the_stop_maps_margin_identical(margin, monkeypatch):
+    """Rays whose reach stays inside the stop map's margin jump through it, the others (origins far off the
+    world, or a map capped small, or none) through the region grid: the same answers, cast after cast while
+    robots move in the hall's empty regions and with none, and the robots' regions set in the map for a cast
+    are reset after it."""
+    rng = np.random.default_rng(77)
+    occ = np.zeros((300, 400), dtype=bool)  # a walled hall with a few walls in it: mostly empty regions
+    occ[[0, -1], :] = occ[:, [0, -1]] = True
+    occ[100:102, 40:200] = occ[150:260, 300] = True
+    casters = [make_caster(occ, RES, ORIGIN, kernels) for kernels in ("numpy", "numba")]
+    regions = casters[1]._grid.slots.size  # the map is made at the first cast
+    limit = {"wide": stop_map.STOP_MAP_LIMIT, "capped": regions + 300, "none": regions - 10}[margin]
+    monkeypatch.setattr(stop_map, "STOP_MAP_LIMIT", limit)
+    layers = [caster.robot_layer() for caster in casters]
+    for cast in range(3):
+        xy, angles, reach = rays(rng, occ, 40, 90)
+        far = rng.random(xy.shape[0] // 90) < 0.3  # scans from up to 40 m off the world, 0.3-30 m long
+        xy[np.repeat(far, 90)] += np.repeat(rng.uniform(-40, 40, (int(far.sum()), 2)), 90, axis=0)
+        owners = np.repeat(rng.integers(-1, 25, 40), 90)
+        rows, cols, ids = crowd(rng, occ, 25)
+        results = []
+        for caster, layer in zip(casters, layers, strict=True):
+            layer.update(rows, cols, ids)
+            robots = layer if cast < 2 else None
+            results.append(caster.cast(xy, angles, reach, owners=owners, robots=robots))
+        assert_identical(results[1], results[0])
+        stops = casters[1]._stops  # the robots' regions are no longer set (a stale one would only cost time)
+        static = stop_map.StopMap(casters[1]._grid.slots).fitted(30 / RES)[0]
+        assert stops.pad < 0 or np.array_equal(stops.cells, static)
+    pad = casters[1]._stops.pad
+    assert {"wide": pad >= int(1.5 * 30 / RES) // 32, "capped": 0 <= pad < 10, "none": pad == -1}[margin]
+
+
+def test_step_count_of_a_jump_is_stages():
+    """The jumps' integer step count is Stage's ``(int)(n - dist)`` (as far as its sign when not positive),
+    also where the jump's fraction lies a hair above a whole number, or the jump is endless or NaN."""
+    import numba
+
+    from stage_sim.sensing import traversal
+
+    steps_after = numba.njit(lambda steps, jumped: traversal._steps_after(steps, jumped))
+    rng = np.random.default_rng(5)
+    whole = np.concatenate([np.arange(0.0, 70.0), rng.integers(0, 3000, 200).astype(float)])
+    tiny = 2.0 ** -np.arange(1, 60)
+    jumps = np.concatenate([whole, np.nextafter(whole, np.inf), np.nextafter(whole, -np.inf),
+                            (whole[:, None] + tiny[None, :]).ravel(), (whole[:, None] - tiny[None, :]).ravel(),
+                            rng.uniform(0, 100, 2000), [1e15, 3e17, 1e300, np.inf, np.nan]])
+    jumps = jumps[~(jumps < 0)]
+    for steps in (1, 2, 3, 31, 64, 1000, 4095, 5657, 123457, 2**31 - 1):
+        for jumped in jumps:
+            stage = np.trunc(float(steps) - jumped)
+            ours = steps_after(steps, jumped)
+            assert (ours > 0) == (stage > 0), (steps, jumped)
+            if stage > 0:
+                assert ours == stage, (steps, jumped)
 
 
 def test_threads_do_not_change_answers():
