@@ -33,7 +33,7 @@ crossing decides where the walk enters the next region holding a block). The ste
 Stage's ``n = (int)(n - dist)``, is kept in a float between regions (``trunc``). A ray whose reach stays inside
 the margin of the :class:`~stage_sim.sensing.stop_map.StopMap` (every ray of a world of ordinary size) jumps in
 :func:`_jump_padded`: it asks that map, a byte per region, whether a region stops it, with no bounds test, and
-counts its steps in an integer, ``n - ceil(dist)`` (:func:`_steps_after`: Stage's value, computed off the chain
+counts its steps in an integer, ``n - ceil(dist)`` (:func:`steps_after_jump`: Stage's value, computed off the chain
 of jumps; ``trunc`` of a float subtraction made each jump wait ~10 cycles for the one before). The loop over
 rays holds the whole walk: a per-ray function taking the arrays had numba count references to each of
 them, 14 atomic operations per ray (about 60 ns, more than a short ray's walk; :func:`_jump_over`, inlined,
@@ -148,7 +148,7 @@ def _jump_over(basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y,
 
 
 @numba.njit(inline="always", **_JIT)
-def _steps_after(steps, jumped):
+def steps_after_jump(steps, jumped):
     """Stage's ``(int)(steps - jumped)`` for a step count ``0 < steps < 2**31`` (where that is not positive,
     a count that is not either).
 
@@ -168,13 +168,13 @@ def _jump_padded(basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_
                  yjumpx, yjumpy, xjumpdist, yjumpdist, stops, stop_row0, stop_col0):
     """:func:`_jump_over` for a ray whose regions all lie in the stop map (rows from region ``stop_row0``,
     columns from ``stop_col0``), with a step count below 2**31: one byte and no bounds test a region, the step
-    count in an integer (the same counts, :func:`_steps_after`)."""
+    count in an integer (the same counts, :func:`steps_after_jump`)."""
     steps = np.int64(steps_left)
     while True:
         basex, basey, jumped, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y = stage_jump(
             xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjumpy, yjumpx, yjumpy, xjumpdist,
             yjumpdist)
-        steps = _steps_after(steps, jumped)
+        steps = steps_after_jump(steps, jumped)
         if steps <= 0:
             break
         row, col = (int(basey) >> REGION_BITS) - stop_row0, (int(basex) >> REGION_BITS) - stop_col0

@@ -242,7 +242,7 @@ def test_step_count_of_a_jump_is_stages():
 
     from stage_sim.sensing import traversal
 
-    steps_after = numba.njit(lambda steps, jumped: traversal._steps_after(steps, jumped))
+    steps_after = numba.njit(lambda steps, jumped: traversal.steps_after_jump(steps, jumped))
     rng = np.random.default_rng(5)
     whole = np.concatenate([np.arange(0.0, 70.0), rng.integers(0, 3000, 200).astype(float)])
     tiny = 2.0 ** -np.arange(1, 60)
