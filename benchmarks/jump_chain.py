@@ -2,10 +2,10 @@
 
 Run with the venv's python: ``taskset -c 0 .venv/bin/python benchmarks/jump_chain.py``. Prints one JSON line
 per beam slope: ns per jump of Stage's jump (the nearer crossing taken, both crossings and distances advanced:
-:func:`~stage_sim.sensing.traversal.stage_jump`) in a loop that does nothing else and looks up no region, with
+:func:`~stage_sim.sensing.region_jumps.stage_jump`) in a loop that does nothing else and looks up no region, with
 the step count as Stage updates it (``trunc`` of a float subtraction, each jump waiting for the one before: the
 walk's count for rays beyond the stop map's margin), as the walk counts it for every other ray (an integer,
-:func:`~stage_sim.sensing.traversal.steps_after_jump`), and with none. ``rl_world_jumps_ms*``: those figures
+:func:`~stage_sim.sensing.region_jumps.steps_after_jump`), and with none. ``rl_world_jumps_ms*``: those figures
 for one step of the 1 mm RL world (``worlds.py``: 102,400 beams, ~95 jumps each), the least its jumps cost.
 """
 
@@ -17,7 +17,7 @@ import time
 import numba
 import numpy as np
 
-from stage_sim.sensing.traversal import stage_jump, steps_after_jump
+from stage_sim.sensing.region_jumps import stage_jump, steps_after_jump
 
 JUMPS = 20_000_000
 RL_BEAMS = 102_400

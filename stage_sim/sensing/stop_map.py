@@ -7,9 +7,10 @@ frequent step of a long beam at a fine resolution (95 jumps a beam on the 1 mm R
 ``benchmarks/worlds.py``). This map answers it with one byte, and with no bounds test for a ray that cannot
 leave the margin: the map reaches :attr:`StopMap.pad` regions beyond the tile grid on every side, more than
 the longest beam cast so far. The robots' regions are set for the length of a cast and reset after it
-(:func:`stage_sim.sensing.traversal.cast_serial`). A region set here that holds nothing would cost the walk a
-look at it and change no answer (the walk finds it empty and jumps on from where it stood); one left unset
-that holds a block would be jumped over, so the map is the static regions and the robots' exactly.
+(:func:`mark_robot_regions`, called by :func:`stage_sim.sensing.traversal.cast_serial`). A region set here that
+holds nothing would cost the walk a look at it and change no answer (the walk finds it empty and jumps on from
+where it stood); one left unset that holds a block would be jumped over, so the map is the static regions and
+the robots' exactly.
 
 What it costs: (R + 2·pad) × (C + 2·pad) bytes for R × C regions: 1.4 MB on the 30 m × 30 m world at 1 mm
 with 4 m beams. The map stays under :data:`STOP_MAP_LIMIT` bytes (a smaller margin then; rays that could
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from stage_sim.maps.tiles import TILE
@@ -59,3 +61,15 @@ def _largest_pad(rows: int, cols: int) -> int:
     while pad > 0 and (rows + 2 * pad) * (cols + 2 * pad) > STOP_MAP_LIMIT:
         pad -= 1
     return pad
+
+
+@numba.njit(cache=True, nogil=True)
+def mark_robot_regions(stops, pad, slots, marked, robots_stop):
+    """Set the stop map at the robot layer's regions (``marked``, flat in the region grid) when
+    ``robots_stop``, else reset them to the static regions' value."""
+    if pad < 0:
+        return
+    rw = slots.shape[1]
+    for f in marked:
+        r, c = f // rw, f % rw
+        stops[r + pad, c + pad] = 1 if robots_stop or slots[r, c] >= 0 else 0

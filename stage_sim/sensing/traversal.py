@@ -28,16 +28,11 @@ never looked at a set cell there. On rooms.world's scans a ray walks 2.2 runs an
 runs; on the 1 mm RL world of ``benchmarks/worlds.py``, whose beams leave their robot's body, 5.6 loops of runs or
 bands instead of 20.9 when tiles holding robot cells were walked run by run.
 
-Between regions, the jumps over empty regions follow Stage's floating-point crossings one by one (each
-crossing decides where the walk enters the next region holding a block). The step count they update,
-Stage's ``n = (int)(n - dist)``, is kept in a float between regions (``trunc``). A ray whose reach stays inside
-the margin of the :class:`~stage_sim.sensing.stop_map.StopMap` (every ray of a world of ordinary size) jumps in
-:func:`_jump_padded`: it asks that map, a byte per region, whether a region stops it, with no bounds test, and
-counts its steps in an integer, ``n - ceil(dist)`` (:func:`steps_after_jump`: Stage's value, computed off the chain
-of jumps; ``trunc`` of a float subtraction made each jump wait ~10 cycles for the one before). The loop over
-rays holds the whole walk: a per-ray function taking the arrays had numba count references to each of
-them, 14 atomic operations per ray (about 60 ns, more than a short ray's walk; :func:`_jump_over`, inlined,
-counts none).
+Between regions, the walk replays Stage's jumps over empty regions one by one
+(:mod:`stage_sim.sensing.region_jumps`: each floating-point crossing decides where it enters the next region
+holding a block). The loop over rays holds the whole walk: a per-ray function taking the arrays had numba count
+references to each of them, 14 atomic operations per ray (about 60 ns, more than a short ray's walk; the jump
+loops, inlined, count none).
 """
 
 from __future__ import annotations
@@ -48,20 +43,14 @@ import numba
 import numpy as np
 from numba.cpython.unsafe.numbers import leading_zeros, trailing_zeros
 
+from stage_sim.sensing.region_jumps import INT_STEPS, jump_through_grid, jump_through_stop_map
 from stage_sim.sensing.stage_walk import REGION, REGION_BITS, ZERO_ANGLE
+from stage_sim.sensing.stop_map import mark_robot_regions
 
 #: Run length standing for "no end" (a line along an axis has a single run).
 _ENDLESS = 1 << 40
 #: Rays per work item of the parallel loop.
 _CHUNK = 64
-#: A jump whose distance lies above a whole number by less than ``1 - _NEAR_WHOLE`` has its step count worked
-#: out in floating point, as Stage does (rounding ``n - dist`` can reach the next whole number there).
-_NEAR_WHOLE = 1.0 - 2.0 ** -20
-#: Jumps at least this long (a beam nearly along an axis: its crossing of the other axis is far) likewise.
-_FAR_JUMP = 2.0 ** 52
-#: Step counts from which the integer count is not used (``n - dist`` rounds to 2**-21 below them).
-_INT_STEPS = 1 << 31
-
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
@@ -90,24 +79,6 @@ def _first(bits, length, step):
 
 
 @numba.njit(inline="always", **_JIT)
-def stage_jump(xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjumpy, yjumpx, yjumpy, xjumpdist,
-               yjumpdist):
-    """Stage's jump over an empty region to the nearer of its two crossings: (the point jumped to, x and y,
-    the distance jumped, then both crossings and their distances for the next jump). Written as selections,
-    which mispredict fewer branches than Stage's if/else."""
-    takex = dist_x < dist_y
-    basex = xcrossx if takex else ycrossx
-    basey = xcrossy if takex else ycrossy
-    jumped = dist_x if takex else dist_y
-    next_xx, next_xy = xcrossx + xjumpx, xcrossy + xjumpy
-    next_yx, next_yy = ycrossx + yjumpx, ycrossy + yjumpy
-    left_y, left_x = dist_y - dist_x, dist_x - dist_y
-    return (basex, basey, jumped, next_xx if takex else xcrossx, next_xy if takex else xcrossy,
-            ycrossx if takex else next_yx, ycrossy if takex else next_yy, xjumpdist if takex else left_x,
-            left_y if takex else yjumpdist)
-
-
-@numba.njit(inline="always", **_JIT)
 def _quot(a, b):
     """``a // b`` for ``a >= 0``, ``b > 0``: an unsigned division, without the sign fix-ups of floor division."""
     return np.int64(np.uint64(a) // np.uint64(b))
@@ -122,65 +93,6 @@ def _free_lines(used, first, step):
         return REGION - first if ahead == 0 else np.int64(trailing_zeros(ahead))
     behind = used & ((np.int64(2) << first) - 1)
     return first + 1 if behind == 0 else first - (63 - np.int64(leading_zeros(behind)))
-
-
-@numba.njit(**_JIT)
-def _jump_over(basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left, xjumpx, xjumpy, yjumpx,
-               yjumpy, xjumpdist, yjumpdist, slots, robot_regions, use_regions, rrow0, rcol0):
-    """Stage's jumps from an empty region until one holding a block (static, or a robot's when
-    ``use_regions``) or the end of the steps: the point jumped to, the crossings and distances, the steps.
-
-    A loop of its own (which the compiler inlines): every value of it stays in a register, where the walk's
-    loop, whose top every jump went through, shared them with everything else (5 % of a step of the 1 mm RL
-    world, whose beams jump 95 times; the same time on rooms.world)."""
-    rh, rw = slots.shape
-    while True:
-        basex, basey, jumped, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y = stage_jump(
-            xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjumpy, yjumpx, yjumpy, xjumpdist,
-            yjumpdist)
-        steps_left = np.trunc(steps_left - jumped)
-        if not steps_left > 0:
-            break
-        rr, rc = (int(basey) >> REGION_BITS) - rrow0, (int(basex) >> REGION_BITS) - rcol0
-        if 0 <= rr < rh and 0 <= rc < rw and (slots[rr, rc] >= 0 or (use_regions and robot_regions[rr, rc] != -1)):
-            break
-    return basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left
-
-
-@numba.njit(inline="always", **_JIT)
-def steps_after_jump(steps, jumped):
-    """Stage's ``(int)(steps - jumped)`` for a step count ``0 < steps < 2**31`` (where that is not positive,
-    a count that is not either).
-
-    For an integer ``steps`` and ``jumped >= 0``, that is ``steps - ceil(jumped)``: ``steps - jumped`` lies
-    strictly between two whole numbers, above ``steps - ceil(jumped)`` by ``ceil(jumped) - jumped``, and rounds
-    to the one above only when that is within half a unit in the last place of it (2**-22 below 2**31); so a
-    jump whose fraction lies below ``2**-20`` (or that is very long, or NaN) is done in floating point."""
-    whole = np.ceil(jumped)
-    if whole - jumped > _NEAR_WHOLE or not whole < _FAR_JUMP:
-        left = np.trunc(float(steps) - jumped)
-        return np.int64(left) if left > 0 else np.int64(0)
-    return steps - np.int64(whole)
-
-
-@numba.njit(**_JIT)
-def _jump_padded(basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left, xjumpx, xjumpy,
-                 yjumpx, yjumpy, xjumpdist, yjumpdist, stops, stop_row0, stop_col0):
-    """:func:`_jump_over` for a ray whose regions all lie in the stop map (rows from region ``stop_row0``,
-    columns from ``stop_col0``), with a step count below 2**31: one byte and no bounds test a region, the step
-    count in an integer (the same counts, :func:`steps_after_jump`)."""
-    steps = np.int64(steps_left)
-    while True:
-        basex, basey, jumped, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y = stage_jump(
-            xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, xjumpx, xjumpy, yjumpx, yjumpy, xjumpdist,
-            yjumpdist)
-        steps = steps_after_jump(steps, jumped)
-        if steps <= 0:
-            break
-        row, col = (int(basey) >> REGION_BITS) - stop_row0, (int(basex) >> REGION_BITS) - stop_col0
-        if stops[np.uint64(row), np.uint64(col)]:  # unsigned: no wrap-around of negative indices to test
-            break
-    return basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, float(max(steps, 0))
 
 
 @numba.njit(**_JIT)
@@ -244,7 +156,7 @@ def _cast_range(world, robots, flags, place, stops, pad, origins, origin_of, hea
             last_origin = o  # stop map: its walk looks at most (n >> REGION_BITS) + 3 regions away either way
             pr, pc = (int(starty) >> REGION_BITS) - stop_row0, (int(startx) >> REGION_BITS) - stop_col0
             room = min(pr, sh - 1 - pr, pc, sw - 1 - pc) - 3
-            room_steps = min(room << REGION_BITS, _INT_STEPS) if room > 0 else 0
+            room_steps = min(room << REGION_BITS, INT_STEPS) if room > 0 else 0
         padded = n < room_steps
         steps_left = float(n)  # the step count as Stage's jumps update it: (int)(n - dist), kept in a float
         while steps_left > 0:
@@ -414,27 +326,16 @@ def _cast_range(world, robots, flags, place, stops, pad, origins, origin_of, hea
                     dist_y = abs(ydx) + abs(ydy)
                 kx = ky = 0  # the loop looks at the region jumped to again, as Stage's does
                 if padded:
-                    basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left = _jump_padded(
+                    jumped = jump_through_stop_map(
                         basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left, xjumpx, xjumpy,
                         yjumpx, yjumpy, xjumpdist, yjumpdist, stops, stop_row0, stop_col0)
                 else:
-                    basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left = _jump_over(
+                    jumped = jump_through_grid(
                         basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left, xjumpx, xjumpy,
                         yjumpx, yjumpy, xjumpdist, yjumpdist, slots, robot_regions, use_regions, rrow0, rcol0)
+                basex, basey, xcrossx, xcrossy, ycrossx, ycrossy, dist_x, dist_y, steps_left = jumped
         cell[i], rid[i] = hit_cell, hit_robot
         out[at] = hit_range if hit_cell >= 0 else rmax[i]
-
-
-@numba.njit(**_JIT)
-def _mark_stops(stops, pad, slots, marked, robots_stop):
-    """Set the stop map at the robot layer's regions (``marked``, flat in the region grid) when
-    ``robots_stop``, else reset them to the static regions' value."""
-    if pad < 0:
-        return
-    rw = slots.shape[1]
-    for f in marked:
-        r, c = f // rw, f % rw
-        stops[r + pad, c + pad] = 1 if robots_stop or slots[r, c] >= 0 else 0
 
 
 @numba.njit(**_JIT)
@@ -453,19 +354,19 @@ def cast_serial(world, robots, flags, place, stops, pad, marked, origins, origin
     at angle ``heading[origin_of[i]] + local[i]`` (+ ``jitter[out_at[i]]`` unless ``jitter`` is empty);
     ``trig``: (angle, cos, sin) of each ``out_at`` slot's last cast, kept up to date (empty arrays: none);
     ``place``: col0, row0, rcol0, rrow0 of the :class:`~stage_sim.maps.tiles.TileGrid` and its width."""
-    _mark_stops(stops, pad, world[3], marked, flags[0])
+    mark_robot_regions(stops, pad, world[3], marked, flags[0])
     _cast_range(world, robots, flags, place, stops, pad, origins, origin_of, heading, local, jitter, trig, rmax, ppm,
                 owner, out_at, out, cell, rid, 0, owner.size)
-    _mark_stops(stops, pad, world[3], marked, False)
+    mark_robot_regions(stops, pad, world[3], marked, False)
 
 
 @numba.njit(parallel=True, **_JIT)
 def cast_parallel(world, robots, flags, place, stops, pad, marked, origins, origin_of, heading, local, jitter, trig,
                   rmax, ppm, owner, out_at, out, cell, rid):
     """Every ray, chunks of rays spread over numba's threads (each ray's answer is independent of them)."""
-    _mark_stops(stops, pad, world[3], marked, flags[0])
+    mark_robot_regions(stops, pad, world[3], marked, flags[0])
     n = owner.size
     for k in numba.prange((n + _CHUNK - 1) // _CHUNK):
         _cast_range(world, robots, flags, place, stops, pad, origins, origin_of, heading, local, jitter, trig, rmax,
                     ppm, owner, out_at, out, cell, rid, k * _CHUNK, min(n, (k + 1) * _CHUNK))
-    _mark_stops(stops, pad, world[3], marked, False)
+    mark_robot_regions(stops, pad, world[3], marked, False)

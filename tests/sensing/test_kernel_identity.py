@@ -240,9 +240,9 @@ def test_step_count_of_a_jump_is_stages():
     also where the jump's fraction lies a hair above a whole number, or the jump is endless or NaN."""
     import numba
 
-    from stage_sim.sensing import traversal
+    from stage_sim.sensing import region_jumps
 
-    steps_after = numba.njit(lambda steps, jumped: traversal.steps_after_jump(steps, jumped))
+    steps_after = numba.njit(lambda steps, jumped: region_jumps.steps_after_jump(steps, jumped))
     rng = np.random.default_rng(5)
     whole = np.concatenate([np.arange(0.0, 70.0), rng.integers(0, 3000, 200).astype(float)])
     tiny = 2.0 ** -np.arange(1, 60)
