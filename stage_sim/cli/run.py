@@ -39,10 +39,13 @@ def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
     from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
+    from stage_sim.sensing.kernels import let_idle_threads_sleep, resolve_threads
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(resolve_world(args.world))
+    speedup = description.settings.speedup if args.speedup is None else args.speedup
+    let_idle_threads_sleep(speedup > 0, resolve_threads())
     sim = Simulation(description, seed=args.seed)
     for warning in sim.warnings:
         print(f"stage_sim run: {warning}", file=sys.stderr)
@@ -56,7 +59,6 @@ def _run(args: argparse.Namespace) -> int:
         except (BagError, ValueError) as exc:
             print(f"stage_sim run: {exc}", file=sys.stderr)
             return 2
-    speedup = description.settings.speedup if args.speedup is None else args.speedup
     end = args.duration
     if description.settings.quit_time > 0:
         end = min(end, description.settings.quit_time)

@@ -21,10 +21,15 @@ WATCHDOG_S = 0.2
 
 
 def run(args: argparse.Namespace) -> int:
+    from stage_sim.sensing.kernels import let_idle_threads_sleep, resolve_threads
     from stage_sim.sim.simulation import Simulation
     from stage_sim.view import LiveView, PacedLoop, view_settings
+    from stage_sim.worldfile.loader import load_world
 
-    sim = Simulation.from_world(resolve_world(args.world), seed=args.seed, watchdog_timeout=args.watchdog)
+    description = load_world(resolve_world(args.world))
+    speedup = description.settings.speedup if args.speedup is None else args.speedup
+    let_idle_threads_sleep(speedup > 0, resolve_threads())
+    sim = Simulation(description, seed=args.seed, watchdog_timeout=args.watchdog)
     for warning in sim.warnings:
         print(f"stage_sim view: {warning}", file=sys.stderr)
     before_step = None
@@ -32,7 +37,6 @@ def run(args: argparse.Namespace) -> int:
         from stage_sim.runs.driver import WanderDriver
 
         before_step = WanderDriver(sim, args.seed).decide
-    speedup = sim.description.settings.speedup if args.speedup is None else args.speedup
     loop = PacedLoop(sim, speedup, before_step)
     view = LiveView(sim, loop, view_settings(args))
     try:

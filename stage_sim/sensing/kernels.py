@@ -86,6 +86,16 @@ def set_threads(threads: int) -> None:
     numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
+def let_idle_threads_sleep(realtime: bool, threads: int) -> None:
+    """Before a run paced to the wall clock on more than one thread: make numba's OpenMP workers sleep
+    between the step's parallel loops instead of spinning through the pause (libgomp's default, right for
+    back-to-back steps: stageros with 100 robots at real time on 2 threads used 18 % of a core, 7 % without;
+    6.6 % on one thread). Acts only if the thread pool has not started yet; a user's own
+    ``OMP_WAIT_POLICY`` wins."""
+    if realtime and threads > 1:
+        os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+
 def announce_compilation(*dispatchers) -> None:
     """Log "compiling simulation kernels, once" if some kernel is neither compiled nor cached on disk."""
     for dispatcher in dispatchers:

@@ -318,3 +318,19 @@ def test_seed_parameter_fixes_the_drawn_odometry_error(ros_context, executor, tm
     assert not np.array_equal(a.sim.odom_errors, c.sim.odom_errors)
     for node in (a, b, c):
         node.destroy_node()
+
+
+def test_real_time_on_two_threads_lets_idle_kernel_threads_sleep(ros_context, tmp_path, monkeypatch) -> None:
+    """Paced to the wall clock, numba's workers sleep between steps instead of spinning; as fast as possible
+    they keep spinning (the next step comes at once)."""
+    import os
+
+    world = write_world(tmp_path, 'bot( pose [2 5 0 0] )')
+    monkeypatch.setenv("OMP_WAIT_POLICY", "")  # restored after the test
+    monkeypatch.delenv("OMP_WAIT_POLICY")
+    fast = StageRos(str(world), autostep=False, node_name="fast", context=ros_context, speedup=0.0, threads=2)
+    assert "OMP_WAIT_POLICY" not in os.environ
+    paced = StageRos(str(world), autostep=False, node_name="paced", context=ros_context, speedup=1.0, threads=2)
+    assert os.environ["OMP_WAIT_POLICY"] == "PASSIVE"
+    for node in (fast, paced):
+        node.destroy_node()
