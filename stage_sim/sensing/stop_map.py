@@ -26,7 +26,7 @@ import numpy as np
 
 from stage_sim.maps.tiles import TILE
 
-#: Largest stop map kept, in bytes (one per region): 64 MB, a world of 6.7 × 10¹⁰ cells.
+#: Largest stop map kept, in bytes (one per region): 64 MB, the regions of 6.6 × 10¹⁰ cells.
 STOP_MAP_LIMIT = 64_000_000
 #: Regions of margin beyond a beam's reach in cells / TILE: the walk's own slack (the last region it looks at
 #: may lie a region past its steps; truncation toward zero and the origin's own region) and one to spare.
@@ -54,7 +54,7 @@ class StopMap:
 
 def _largest_pad(rows: int, cols: int) -> int:
     """The widest margin keeping (rows + 2·pad)(cols + 2·pad) within :data:`STOP_MAP_LIMIT`; -1 if none does
-    (a tiny 1 × 1 map with margin 0 is kept then, which no ray fits in)."""
+    (the map stays then the 1 × 1 placeholder with margin -1, which no ray fits in)."""
     if rows * cols > STOP_MAP_LIMIT:
         return -1
     pad = int((-(rows + cols) + math.sqrt((rows + cols) ** 2 + 4 * (STOP_MAP_LIMIT - rows * cols))) / 4)
