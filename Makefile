@@ -51,7 +51,8 @@ test: setup
 
 # Every row of issue #14's table: rays/s; both laser cases for 1-1000 robots (numba on one core, numba on 2
 # threads, numpy on one core at 1 and 100 robots, for the ratio; one configuration per process, so that each
-# peak_rss_mb is its own); stageros --speedup 0; start to first scan; the two large worlds.
+# peak_rss_mb is its own); stageros --speedup 0; start to first scan; the two large worlds (and the RL one on 2
+# threads).
 SHORT_LASER := --beams 240 --fov 240 --range 5.6
 LONG_LASER := --beams 1081 --fov 270 --range 30
 bench: setup
@@ -64,6 +65,7 @@ bench: setup
 	$(PY) benchmarks/stageros.py
 	$(PY) benchmarks/startup.py
 	taskset -c 0 $(PY) benchmarks/worlds.py
+	$(PY) benchmarks/worlds.py --worlds rl --threads 2
 	taskset -c 0 $(PY) benchmarks/jump_chain.py
 
 lint: setup

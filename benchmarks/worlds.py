@@ -1,11 +1,14 @@
 """Large worlds in bounded memory: load time, peak RSS and speed of the two big worlds of issue #14.
 
 Run with the venv's python: ``.venv/bin/python benchmarks/worlds.py [--worlds floorplan rl] [--seconds S]
-[--kernels numba|numpy]``.
+[--kernels numba|numpy] [--threads N] [--rl-range METRES]``.
 Each world runs in its own process (so that each peak RSS is its own) and prints one JSON line: world,
-cells (H, W of the world's bounding box), robots, beams, load_s (world file → ready ``Simulation``, kernels
-cached; ``import_s`` before it: Python, numpy, numba and stage_sim), steps, realtime_factor, ms_per_step,
-peak_rss_mb (the whole process, imports included).
+cells (H, W of the world's bounding box), robots, beams, laser_range_m, threads, load_s (world file → ready
+``Simulation``, kernels cached; ``import_s`` before it: Python, numpy, numba and stage_sim), steps,
+realtime_factor, ms_per_step, peak_rss_mb (the whole process, imports included).
+
+``--rl-range`` shortens (or lengthens) the RL world's lasers, everything else equal: a sweep of it shows where
+a step's time goes along a beam (inside the robot's own body, then over the empty regions beyond).
 
 * ``floorplan``: Stage's SFU demo shape: a 1200 m × 600 m floorplan from a 1200 × 615 bitmap at resolution
   0.05 (24000 × 12000 cells), one robot with a 240-beam 240° 5.6 m laser. Stage's own bitmap when the
@@ -53,9 +56,11 @@ resolution 0.001
 interval_sim 100
 define map model ( color "gray30" boundary 1 obstacle_return 1 ranger_return 1 )
 map( size [30.000 30.000 0.500] pose [15 15 0 0] bitmap "{bitmap}" )
-define laser ranger ( sensor( range [0.0 4.0] fov 180 samples 512 ) size [0.05 0.05 0.05] )
+define laser ranger ( sensor( range [0.0 {laser_range}] fov 180 samples 512 ) size [0.05 0.05 0.05] )
 define bot position ( size [0.24 0.24 0.25] drive "diff" bitmap "{robot}" laser( pose [0 0 -0.1 0] ) )
 """
+#: The RL world's laser range (m), as issue #14 describes those worlds.
+RL_RANGE = 4.0
 
 
 def office_bitmap(path: Path, width: int, height: int, room: int, seed: int) -> np.ndarray:
@@ -110,8 +115,9 @@ def free_spots(walls: np.ndarray, metres: tuple[float, float], corner: tuple[flo
     return spots[np.random.default_rng(seed).permutation(len(spots))[:count]]
 
 
-def world_text(name: str, folder: Path) -> str:
-    """The world file of case ``name``, its bitmaps written into ``folder``."""
+def world_text(name: str, folder: Path, rl_range: float = RL_RANGE) -> str:
+    """The world file of case ``name``, its bitmaps written into ``folder`` (``rl_range``: the RL world's
+    laser range)."""
     if name == "floorplan":
         if SFU.exists():
             from PIL import Image
@@ -130,10 +136,10 @@ def world_text(name: str, folder: Path) -> str:
     spots = free_spots(walls, (30.0, 30.0), (0.0, 0.0), 0.3, 200, seed=3)
     yaws = np.random.default_rng(4).uniform(-180, 180, len(spots))
     robots = "".join(f"bot( pose [{x:.3f} {y:.3f} 0 {a:.1f}] )\n" for (x, y), a in zip(spots, yaws, strict=True))
-    return RL.format(bitmap=folder / "rl_map.png", robot=folder / "robot.png") + robots
+    return RL.format(bitmap=folder / "rl_map.png", robot=folder / "robot.png", laser_range=rl_range) + robots
 
 
-def measure(name: str, seconds: float, kernels: str) -> dict:
+def measure(name: str, seconds: float, kernels: str, threads: int, rl_range: float) -> dict:
     """Load the world, drive every robot in a circle for ``seconds`` of sim time, report."""
     from stage_sim.sensing.kernels import numba_available
     from stage_sim.sim.simulation import Simulation
@@ -142,10 +148,10 @@ def measure(name: str, seconds: float, kernels: str) -> dict:
     numba_available()  # the import of numba counts as an import, not as loading the world
     imported = time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
-        text = world_text(name, Path(folder))
+        text = world_text(name, Path(folder), rl_range)
         begin = time.perf_counter()
         sim = Simulation(load_world_text(text, str(Path(folder) / f"{name}.world")), seed=1, kernels=kernels,
-                         threads=1)
+                         threads=threads)
         load = time.perf_counter() - begin
     for i in range(len(sim.robots)):
         sim.set_velocity(i, 0.3, 0.0, 0.5)
@@ -161,6 +167,8 @@ def measure(name: str, seconds: float, kernels: str) -> dict:
         "resolution": sim.static.resolution,
         "robots": len(sim.robots),
         "beams": int(sum(r.sensor.samples for robot in sim.robots for r in robot.rangers)),
+        "laser_range_m": max(r.sensor.range_max for robot in sim.robots for r in robot.rangers),
+        "threads": threads,
         "import_s": round(imported - START, 2),
         "load_s": round(load, 2),
         "steps": steps,
@@ -176,14 +184,16 @@ def main() -> None:
     parser.add_argument("--worlds", nargs="+", choices=("floorplan", "rl"), default=["floorplan", "rl"])
     parser.add_argument("--seconds", type=float, default=10.0, help="sim seconds per world")
     parser.add_argument("--kernels", choices=("numba", "numpy"), default="numba")
+    parser.add_argument("--threads", type=int, default=1, help="numba threads (the table's rows: 1)")
+    parser.add_argument("--rl-range", type=float, default=RL_RANGE, help="the RL world's laser range (m)")
     parser.add_argument("--child", choices=("floorplan", "rl"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        print(json.dumps(measure(args.child, args.seconds, args.kernels)), flush=True)
+        print(json.dumps(measure(args.child, args.seconds, args.kernels, args.threads, args.rl_range)), flush=True)
         return
     for name in args.worlds:
         subprocess.run([sys.executable, __file__, "--child", name, "--seconds", str(args.seconds), "--kernels",
-                        args.kernels], check=True)
+                        args.kernels, "--threads", str(args.threads), "--rl-range", str(args.rl_range)], check=True)
 
 
 if __name__ == "__main__":
