@@ -19,6 +19,7 @@ from typing import Any
 from stage_sim.cli.arguments import positive, resolve_world
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
 from stage_sim.runs.interrupts import stop_requests
+from stage_sim.sensing.kernels import add_kernel_arguments
 
 
 def run(args: argparse.Namespace) -> int:
@@ -39,14 +40,14 @@ def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
     from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
-    from stage_sim.sensing.kernels import let_idle_threads_sleep, resolve_threads
+    from stage_sim.sensing.kernels import threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(resolve_world(args.world))
     speedup = description.settings.speedup if args.speedup is None else args.speedup
-    let_idle_threads_sleep(speedup > 0, resolve_threads())
-    sim = Simulation(description, seed=args.seed)
+    threads = threads_for_run(args.threads, speedup)
+    sim = Simulation(description, seed=args.seed, kernels=args.kernels, threads=threads)
     for warning in sim.warnings:
         print(f"stage_sim run: {warning}", file=sys.stderr)
     recorder = None
@@ -79,7 +80,8 @@ def _run(args: argparse.Namespace) -> int:
         summary = recorder.close() if recorder else None
     wall = time.monotonic() - start
     print(f"{description.path.name}: {sim.sim_time:g} s of sim time in {wall:.2f} s of wall time "
-          f"({sim.sim_time / wall if wall > 0 else float('inf'):.1f}x real time)")
+          f"({sim.sim_time / wall if wall > 0 else float('inf'):.1f}x real time; {sim.kernels} kernels, "
+          f"{sim.threads} thread{'s' if sim.threads > 1 else ''})")
     if summary:
         print(summary.describe(), file=sys.stderr if summary.error or summary.dropped_steps else sys.stdout)
     return 1 if summary and summary.error else 0
@@ -100,6 +102,7 @@ def add_command(subparsers: Any) -> None:
         "--controller", choices=sorted(CONTROLLERS), default="straight",
         help=f"who drives: 'straight' at {STRAIGHT_SPEED} m/s, or the wander node's strategy (default straight)")
     parser.add_argument("--seed", type=int, default=None, help="simulation (and wanderer) seed")
+    add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
     parser.add_argument("-u", action="store_true", dest="use_model_names",
                         help="name robots' topics and frames after their models (as stageros -u)")
     parser.add_argument("--bag", type=Path, metavar="OUT.mcap", help="record a ROS 2 bag (MCAP) of the run")

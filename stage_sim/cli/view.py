@@ -14,6 +14,7 @@ import threading
 from typing import Any
 
 from stage_sim.cli.arguments import resolve_world
+from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.view.options import add_view_arguments
 
 WATCHDOG_S = 0.2
@@ -21,15 +22,15 @@ WATCHDOG_S = 0.2
 
 
 def run(args: argparse.Namespace) -> int:
-    from stage_sim.sensing.kernels import let_idle_threads_sleep, resolve_threads
+    from stage_sim.sensing.kernels import threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.view import LiveView, PacedLoop, view_settings
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(resolve_world(args.world))
     speedup = description.settings.speedup if args.speedup is None else args.speedup
-    let_idle_threads_sleep(speedup > 0, resolve_threads())
-    sim = Simulation(description, seed=args.seed, watchdog_timeout=args.watchdog)
+    sim = Simulation(description, seed=args.seed, watchdog_timeout=args.watchdog, kernels=args.kernels,
+                     threads=threads_for_run(args.threads, speedup))
     for warning in sim.warnings:
         print(f"stage_sim view: {warning}", file=sys.stderr)
     before_step = None
@@ -66,6 +67,7 @@ def add_command(subparsers: Any) -> None:
     parser.add_argument("--speedup", type=float, default=None,
                         help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
     parser.add_argument("--seed", type=int, default=None, help="seed for odometry errors, noise and the wanderer")
+    add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
     parser.add_argument("--watchdog", type=float, default=WATCHDOG_S,
                         help=f"sim seconds a command lasts without a new one (default {WATCHDOG_S}; <= 0: forever)")
     parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")

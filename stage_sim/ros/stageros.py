@@ -37,7 +37,7 @@ from stage_sim.bags.names import RobotNames, robot_names
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
 from stage_sim.ros.rival_publishers import RivalPublishers
-from stage_sim.sensing.kernels import let_idle_threads_sleep, resolve_threads
+from stage_sim.sensing.kernels import threads_for_run
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.loader import load_world
@@ -99,10 +99,8 @@ class StageRos(Node):
         self.publish_map = bool(self.declare_parameter("publish_map", False).value)
         stamped = bool(self.declare_parameter("use_stamped_velocity", False).value)
 
-        threads = resolve_threads(threads, default=0 if self.speedup <= 0 else 1)
-        let_idle_threads_sleep(self.speedup > 0, threads)
         self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog,
-                              kernels=kernels, threads=threads)
+                              kernels=kernels, threads=threads_for_run(threads, self.speedup))
         for warning in self.sim.warnings:
             self.get_logger().warning(str(warning))
         robots = self.sim.robots

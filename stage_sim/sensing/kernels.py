@@ -96,6 +96,15 @@ def let_idle_threads_sleep(realtime: bool, threads: int) -> None:
         os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 
+def threads_for_run(requested: int | None, speedup: float) -> int:
+    """Threads of a run at ``speedup`` (<= 0: as fast as possible): the argument, else ``$STAGE_SIM_THREADS``,
+    else 1 when paced to the wall clock and all cores when not; idle workers of a paced run then sleep
+    (:func:`let_idle_threads_sleep`). What ``stageros``, ``stage_sim run`` and ``stage_sim view`` use."""
+    threads = resolve_threads(requested, default=0 if speedup <= 0 else 1)
+    let_idle_threads_sleep(speedup > 0, threads)
+    return threads
+
+
 def announce_compilation(*dispatchers) -> None:
     """Log "compiling simulation kernels, once" if some kernel is neither compiled nor cached on disk."""
     for dispatcher in dispatchers:

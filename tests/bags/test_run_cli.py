@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import resource
 import signal
 import subprocess
@@ -54,6 +55,26 @@ def wait_for_chunks(path: Path, chunks: int, process: subprocess.Popen, timeout_
         if path.exists() and path.stat().st_size > 0:
             sizes.add(path.stat().st_size)
         time.sleep(0.02)
+
+
+def test_kernels_and_threads_choose_how_a_run_is_computed_not_what_it_records(tmp_path) -> None:
+    world = two_robot_world(tmp_path)
+    env = {k: v for k, v in os.environ.items() if k not in ("STAGE_SIM_KERNELS", "STAGE_SIM_THREADS")}
+    cores = len(os.sched_getaffinity(0))
+    bags = []
+    for name, options, summary in (
+            ("numpy", ["--kernels", "numpy", "--threads", "1"], "numpy kernels, 1 thread)"),
+            ("numba", ["--kernels", "numba", "--threads", "2"], "numba kernels, 2 threads)"),
+            # as fast as possible, nothing chosen: every core
+            ("unchosen", [], f"kernels, {cores} thread{'s' if cores > 1 else ''})")):
+        (tmp_path / name).mkdir()
+        bag_path = tmp_path / name / "run.mcap"  # the same name: the bag's metadata holds it
+        result = stage_sim("run", world, "--duration", "2", "--speedup", "0", "--seed", "5", "--bag", bag_path,
+                           *options, env=env)
+        assert result.returncode == 0, result.stderr
+        assert summary in result.stdout.splitlines()[0]
+        bags.append(bag_path.read_bytes())
+    assert bags[0] == bags[1] == bags[2]
 
 
 def test_core_only_run_records_what_the_simulation_had_without_importing_ros(tmp_path) -> None:

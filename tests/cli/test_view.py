@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import urllib.request
@@ -45,3 +46,23 @@ def test_a_broken_world_is_a_clear_error(tmp_path) -> None:
     assert f"{broken}:2:" in result.stderr
     assert "Traceback" not in result.stderr
     assert "view: " not in result.stdout
+
+
+def test_kernels_and_threads_reach_the_simulation(monkeypatch) -> None:
+    from stage_sim.cli import main
+    from stage_sim.sim import simulation
+
+    made = []
+
+    class Recorded(simulation.Simulation):
+        def __init__(self, *args, **kwargs) -> None:
+            made.append(kwargs)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(simulation, "Simulation", Recorded)
+    monkeypatch.delenv("STAGE_SIM_THREADS", raising=False)
+    assert main(["view", "rooms.world", "--duration", "0.2", "--view-port", "0", "--kernels", "numpy",
+                 "--threads", "2"]) == 0
+    assert main(["view", "rooms.world", "--duration", "0.2", "--view-port", "0", "--speedup", "0"]) == 0
+    cores = len(os.sched_getaffinity(0))
+    assert [(m["kernels"], m["threads"]) for m in made] == [("numpy", 2), (None, cores)]  # unpaced: every core

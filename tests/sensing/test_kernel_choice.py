@@ -45,6 +45,20 @@ def test_idle_threads_sleep_only_in_paced_runs_on_several_threads(monkeypatch):
     assert choice.os.environ["OMP_WAIT_POLICY"] == "ACTIVE"
 
 
+def test_a_paced_run_takes_one_thread_an_unpaced_one_every_core(monkeypatch):
+    monkeypatch.delenv(choice.THREADS_ENV, raising=False)
+    monkeypatch.setenv("OMP_WAIT_POLICY", "")  # restored after the test
+    monkeypatch.delenv("OMP_WAIT_POLICY")
+    cores = len(choice.os.sched_getaffinity(0))
+    assert choice.threads_for_run(None, 1.0) == 1
+    assert choice.threads_for_run(None, 0.0) == cores
+    assert "OMP_WAIT_POLICY" not in choice.os.environ
+    assert choice.threads_for_run(2, 4.0) == 2
+    assert choice.os.environ["OMP_WAIT_POLICY"] == "PASSIVE"  # paced on several threads: idle workers sleep
+    monkeypatch.setenv(choice.THREADS_ENV, "3")
+    assert choice.threads_for_run(None, 0.0) == 3
+
+
 def test_numba_that_does_not_import_falls_back_to_numpy_with_one_warning(monkeypatch):
     monkeypatch.delenv(choice.KERNELS_ENV, raising=False)
     monkeypatch.setitem(sys.modules, "numba", None)  # `import numba` now raises ImportError
