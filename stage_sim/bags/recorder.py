@@ -83,6 +83,7 @@ class BagRecorder:
                 if topic in self._wanted:
                     self._bag.write(topic, log_time, data)
                     self.messages += 1
+            self._bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             self._bag.abort()
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None

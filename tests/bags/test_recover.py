@@ -12,7 +12,7 @@ import pytest
 from stage_sim.bags.errors import BagError
 from stage_sim.bags.recover import NothingRecovered, recover
 from tests.bags.readers import READERS
-from tests.bags.test_run_cli import stage_sim
+from tests.bags.test_run_cli import stage_sim, start, wait_for_chunks
 from tests.bags.worlds import two_robot_world
 
 
@@ -105,3 +105,19 @@ def test_a_cut_anywhere_recovers_what_was_before_it(tmp_path, complete_bag, frac
 def test_an_unwritable_output_is_a_clear_error(tmp_path, complete_bag) -> None:
     with pytest.raises(BagError, match="cannot write"):
         recover(cut(tmp_path, complete_bag, 0.5), tmp_path / "no" / "such" / "dir.mcap")
+
+
+def test_a_kill_9_at_real_time_loses_about_a_second(tmp_path) -> None:
+    """Chunks close after a sim second: a slow recording (two robots at real time fill a 1 MiB chunk in
+    ~14 s) reaches the disk chunk after chunk within seconds, /tf_static first, and survives a kill -9."""
+    bag_path = tmp_path / "killed.mcap"
+    process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "1", "--bag", bag_path)
+    wait_for_chunks(bag_path, 3, process, timeout_s=15.0)  # the latched messages, then two chunks of steps
+    process.kill()
+    process.communicate()
+    result = recover(bag_path, tmp_path / "out.mcap")
+    bag = READERS["rosbags"](tmp_path / "out.mcap")
+    assert len(bag.messages["/tf_static"]) == 1
+    clocks = [t for t, _ in bag.messages["/clock"]]
+    assert len(clocks) >= 5 and clocks == [100_000_000 * (i + 1) for i in range(len(clocks))]
+    assert result.stopped_at is not None
