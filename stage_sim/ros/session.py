@@ -131,12 +131,12 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     try:
         with stop_requests() as stop:
             session = WanderSession(args.world, args.speedup, args.seed)
-            with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog),
+            with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog) as recorder,
                   viewing(session.stage, args)):
                 session.run(args.duration, stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)
-        return 0
+        return 0 if recorder is None or recorder.summary.complete else 1
     except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2
