@@ -48,7 +48,7 @@ class WanderSession:
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
             prefix = names.cmd_vel[: -len("cmd_vel")]
             remap = ["--ros-args", "-r", f"base_scan:={names.scans[0][len(prefix):]}"] if robot.rangers else None
-            overrides = [Parameter("holonomic", value=robot.settings.drive == "omni")]
+            overrides = [Parameter("holonomic", value=robot.drive.holonomic)]
             if seed is not None:
                 overrides.append(Parameter("seed", value=wanderer_seed(seed, index)))
             self.wanderers.append(Wander(
