@@ -1,21 +1,31 @@
 """Where a robot may start and where its goal may be: free space with room for the body, reachable.
 
-A cell is a valid centre when the nearest cell that blocks the robots (their collision layer, the grid's
-edge included) is farther than the robot's radius plus a margin, measured by an exact Euclidean distance
-transform. Valid cells are grouped into 8-connected regions, so that a goal is always drawn in the region
-of its start: a robot is never asked to reach a closed room. All draws come from the caller's generator.
+A cell is a valid centre when the nearest cell that blocks the robots is farther than the robot's radius plus
+a margin, measured by an exact Euclidean distance transform. What blocks is the *filled* footprint of every
+static body that the robots collide with (the grid's edge included): contacts and rays see only a block's
+outline, as in Stage, so a robot drawn inside a block would never notice it. Valid cells are grouped into
+8-connected regions, so that a goal is always drawn in the region of its start: a robot is never asked to
+reach a closed room.
+
+Draws are uniform over the valid cells that keep the required distances: a few batches of random candidates
+first (the common, cheap case), then, if none fits, every valid cell at once, so a draw fails only when no
+cell fits at all. A start whose region has no room for its goal is drawn again from the other regions. All
+draws come from the caller's generator.
 """
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from scipy import ndimage
+from scipy.spatial import cKDTree
 
 from stage_sim.sim.simulation import Simulation
 
-#: Candidates drawn per attempt when placing one robot; attempts stop after :data:`MAX_ATTEMPTS`.
+#: Candidates drawn per batch, and batches tried, before every valid cell is looked at.
 BATCH = 64
-MAX_ATTEMPTS = 50
+QUICK_BATCHES = 4
 
 
 class PlacementError(ValueError):
@@ -30,13 +40,18 @@ class FreeSpace:
         static.grid.check_dense("placing robots in free space (a distance transform of the whole world)")
         blocked = np.zeros(static.shape, dtype=bool)
         for band in {sim.robots[i].z_band for i in robots}:
-            blocked |= static.collision_layer(*band)
+            blocked |= static.filled_collision_layer(*band)
         padded = np.pad(blocked, 1, constant_values=True)
         clearance = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution
         self.radius = max(sim.robots[i].radius for i in robots)
         valid = clearance > self.radius + margin + static.resolution
-        self.regions, _ = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
+        self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
         self.cells = np.flatnonzero(valid)
+        labels = self.regions.ravel()[self.cells]
+        order = np.argsort(labels, kind="stable")
+        ends = np.searchsorted(labels[order], np.arange(1, count + 2))
+        self._region_cells = [self.cells[order[a:b]] for a, b in itertools.pairwise(ends)]
+        """The valid cells of region r at index r - 1, in increasing order."""
         self.resolution = static.resolution
         self.origin = np.asarray(static.origin_xy, dtype=np.float64)
         self.width = static.shape[1]
@@ -58,24 +73,26 @@ class FreeSpace:
 
     def draw(
         self, rng: np.random.Generator, avoid: np.ndarray, separation: float, region: int = 0,
-        away_from: np.ndarray | None = None, min_distance: float = 0.0,
+        away_from: np.ndarray | None = None, min_distance: float = 0.0, excluded: frozenset[int] = frozenset(),
     ) -> np.ndarray:
-        """One valid point at least ``separation`` from every row of ``avoid`` (M, 2), in ``region`` (0: any)
-        and at least ``min_distance`` from ``away_from``."""
-        pool = self.cells if region == 0 else self.cells[self.regions.ravel()[self.cells] == region]
-        for _ in range(MAX_ATTEMPTS):
-            points = self.centres(pool[rng.integers(len(pool), size=BATCH)])
-            ok = np.ones(BATCH, dtype=bool)
-            if len(avoid):
-                ok &= np.min(np.linalg.norm(points[:, None] - avoid[None], axis=-1), axis=1) >= separation
-            if away_from is not None:
-                ok &= np.linalg.norm(points - away_from, axis=1) >= min_distance
-            if ok.any():
-                return points[np.argmax(ok)]
+        """One valid point at least ``separation`` from every row of ``avoid`` (M, 2), in ``region`` (0: any
+        but ``excluded``) and at least ``min_distance`` from ``away_from``; PlacementError if none exists."""
+        pool = self._pool(region, excluded)
+        fits = _Fits(avoid, separation, away_from, min_distance)
+        if pool.size:
+            for _ in range(QUICK_BATCHES):
+                points = self.centres(pool[rng.integers(len(pool), size=BATCH)])
+                ok = fits(points)
+                if ok.any():
+                    return points[np.argmax(ok)]
+            every = self.centres(pool)
+            ok = np.flatnonzero(fits(every))
+            if ok.size:
+                return every[ok[rng.integers(ok.size)]]
         raise PlacementError(
-            f"could not place a robot {separation:.2f} m from the others"
+            f"no room for a robot {separation:.2f} m from the others"
             + (f" and {min_distance:.2f} m from its start" if away_from is not None else "")
-            + f" after {MAX_ATTEMPTS * BATCH} tries: use fewer robots, a shorter goal distance or a larger world")
+            + ": use fewer robots, a shorter goal distance or a larger world")
 
     def starts_and_goals(
         self, rng: np.random.Generator, count: int, fixed: np.ndarray, min_goal_distance: float
@@ -86,10 +103,43 @@ class FreeSpace:
         goals = np.empty((count, 2))
         for i in range(count):
             placed = np.concatenate([fixed.reshape(-1, 2), starts[:i, :2]])
-            start = self.draw(rng, placed, separation)
-            region = int(self.region_of(start[None])[0])
-            goal = self.draw(rng, np.concatenate([fixed.reshape(-1, 2), goals[:i]]), separation, region,
-                             start, min_goal_distance)
+            taken = np.concatenate([fixed.reshape(-1, 2), goals[:i]])
+            excluded: set[int] = set()  # regions found to have no room for a goal
+            while True:
+                start = self.draw(rng, placed, separation, excluded=frozenset(excluded))
+                region = int(self.region_of(start[None])[0])
+                try:
+                    goal = self.draw(rng, taken, separation, region, start, min_goal_distance)
+                    break
+                except PlacementError:
+                    excluded.add(region)
             starts[i] = (*start, rng.uniform(-np.pi, np.pi))
             goals[i] = goal
         return starts, goals
+
+    def _pool(self, region: int, excluded: frozenset[int]) -> np.ndarray:
+        """The valid cells of ``region`` (0: of every region but ``excluded``)."""
+        if region:
+            return self._region_cells[region - 1]
+        if excluded:
+            return np.concatenate([c for r, c in enumerate(self._region_cells, 1) if r not in excluded] or [[]])
+        return self.cells
+
+
+class _Fits:
+    """Which candidate points keep ``separation`` from ``avoid`` and ``min_distance`` from ``away_from``."""
+
+    def __init__(self, avoid: np.ndarray, separation: float, away_from: np.ndarray | None, min_distance: float):
+        self.tree = cKDTree(avoid) if len(avoid) else None
+        self.separation = separation
+        self.away_from = away_from
+        self.min_distance = min_distance
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        ok = np.ones(len(points), dtype=bool)
+        if self.tree is not None:
+            nearest, _ = self.tree.query(points, distance_upper_bound=self.separation)
+            ok &= nearest >= self.separation
+        if self.away_from is not None:
+            ok &= np.linalg.norm(points - self.away_from, axis=1) >= self.min_distance
+        return ok

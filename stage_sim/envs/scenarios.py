@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stage_sim.envs.free_space import FreeSpace
+from stage_sim.envs.free_space import FreeSpace, PlacementError
 from stage_sim.envs.worlds import RobotBody, WorldSource, obstacles_text, robots_text, world_centre
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.description import WorldDescription
@@ -106,6 +106,17 @@ class Scenario:
         space = self._space[1]
         others = np.array([r.start[:2] for r in sim.robots if r.index not in agents]).reshape(-1, 2)
         return space.starts_and_goals(rng, len(agents), others, self.options.min_goal_distance)
+
+    def check_room(self, sim: Simulation, agents: list[int]) -> None:
+        """Refuse, before any episode, a scenario whose world cannot hold its robots and their goals: one
+        trial placement in the base world (raises PlacementError saying what does not fit)."""
+        if self.options.scenario == "circle":
+            return
+        try:
+            self.place(sim, agents, np.random.default_rng(0))
+        except PlacementError as error:
+            raise PlacementError(f"the {self.options.scenario!r} scenario cannot hold {len(agents)} robot(s) with "
+                                 f"goals {self.options.min_goal_distance:g} m away in this world: {error}") from None
 
     def _circle(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         angles = rng.uniform(-math.pi, math.pi) + 2 * math.pi * np.arange(count) / count

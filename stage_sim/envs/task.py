@@ -105,6 +105,7 @@ class NavigationTask:
         self.active = np.zeros(count, dtype=bool)
         self.distance = np.zeros(count)
         self.steps = 0
+        scenario.check_room(self._base, self.agents)
 
     def reset(self, rng: np.random.Generator) -> np.ndarray:
         """A new episode drawn from ``rng``; returns the (A, D) first observations."""

@@ -122,6 +122,17 @@ class StaticRaster:
         """Dense grid of the cells that block a body spanning [z_low, z_high] (small worlds only)."""
         return self.collision_tiles(z_low, z_high).dense("a dense collision layer")
 
+    def filled_collision_layer(self, z_low: float, z_high: float) -> np.ndarray:
+        """Dense grid of the filled footprints of the bodies that block a body spanning [z_low, z_high]: where a
+        robot may not stand (contacts see only outlines, as in Stage, so a robot placed inside a block would
+        never notice it). Small worlds only."""
+        self.grid.check_dense("a dense filled collision layer")
+        filled = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
+        for body in self.bodies:
+            if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low:
+                filled[body.cells] = True
+        return filled.reshape(self.shape)
+
     @property
     def occupied(self) -> np.ndarray:
         """Cells of any static body's filled footprint, whatever its height or flags (a map, not the raster)."""

@@ -1,0 +1,86 @@
+"""Starts and goals are drawn from free space as a robot sees it: never inside a block (whose inside Stage's
+raster leaves empty), the whole footprint clear of walls and of the other robots, and a reset never fails
+for a scenario that can hold its robots (one that cannot is refused when the env is made)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stage_sim.envs import RobotBody
+from stage_sim.envs.free_space import PlacementError
+from stage_sim.envs.scenarios import Scenario, ScenarioOptions
+from stage_sim.envs.task import NavigationTask, TaskConfig
+from stage_sim.sim.simulation import Simulation
+
+SEEDS = 1000
+SMALL = RobotBody(laser_samples=16)
+YAWS = np.linspace(-math.pi, math.pi, 16, endpoint=False)
+
+
+def footprint_cells(sim: Simulation, robot: int, x: float, y: float, yaws: np.ndarray) -> np.ndarray:
+    """Flat cells under the robot's outline at (x, y) for each yaw, and under its centre."""
+    outline = sim.robots[robot].outline
+    points = [np.array([[x, y]])]
+    for yaw in yaws:
+        c, s = math.cos(yaw), math.sin(yaw)
+        points.append(outline @ np.array([[c, s], [-s, c]]) + (x, y))
+    static = sim.static
+    cells = np.floor((np.concatenate(points) - static.origin_xy) / static.resolution).astype(int)
+    assert (cells >= 0).all() and (cells[:, 0] < static.shape[1]).all() and (cells[:, 1] < static.shape[0]).all()
+    return cells[:, 1] * static.shape[1] + cells[:, 0]
+
+
+def check(sim: Simulation, agents: list[int], starts: np.ndarray, goals: np.ndarray) -> None:
+    """Every footprint (start at its yaw, goal at any yaw) off the filled static world and off the others'."""
+    filled = sim.static.occupied.ravel()  # every static body's filled footprint (all of them block here)
+    for agent, (x, y, yaw), goal in zip(agents, starts, goals, strict=True):
+        assert not filled[footprint_cells(sim, agent, x, y, np.array([yaw]))].any(), (x, y)
+        assert not filled[footprint_cells(sim, agent, *goal, YAWS)].any(), goal
+    others = [r.index for r in sim.robots if r.index not in agents]
+    centres = np.concatenate([starts[:, :2], np.array([sim.robots[o].start[:2] for o in others]).reshape(-1, 2)])
+    radii = np.array([sim.robots[i].radius for i in [*agents, *others]])
+    gaps = np.linalg.norm(centres[:, None] - centres[None], axis=-1) - radii[:, None] - radii[None]
+    np.fill_diagonal(gaps, np.inf)
+    assert gaps.min() > 0, "two bodies overlap"
+
+
+@pytest.mark.parametrize("options", [
+    ScenarioOptions(world="rooms.world", body=SMALL),  # 6 of 300 seeds failed, 2 started inside a block
+    ScenarioOptions(scenario="random", n_robots=4, body=SMALL),
+    ScenarioOptions(world="rooms.world", n_robots=12, body=SMALL),
+], ids=["rooms", "random-4", "rooms-12"])
+def test_a_thousand_resets_of_a_fixed_world(options: ScenarioOptions) -> None:
+    scenario = Scenario(options)
+    sim = Simulation(scenario.base, kernels="numba")
+    agents = list(range(len(sim.robots)))
+    scenario.check_room(sim, agents)
+    for seed in range(SEEDS):
+        starts, goals = scenario.place(sim, agents, np.random.default_rng(seed))
+        check(sim, agents, starts, goals)
+        assert (np.linalg.norm(goals - starts[:, :2], axis=1) >= options.min_goal_distance).all()
+
+
+def test_a_thousand_resets_with_fresh_obstacles() -> None:
+    scenario = Scenario(ScenarioOptions(scenario="obstacles", body=SMALL))
+    base = Simulation(scenario.base, kernels="numba")
+    for seed in range(SEEDS):
+        rng = np.random.default_rng(seed)
+        sim = Simulation(scenario.world(rng, base), kernels="numba")
+        starts, goals = scenario.place(sim, [0], rng)
+        check(sim, [0], starts, goals)
+
+
+def test_the_env_resets_on_every_seed_that_failed_before() -> None:
+    task = NavigationTask(Scenario(ScenarioOptions(world="rooms.world", body=SMALL)), TaskConfig())
+    for seed in (9, 14, 72, 105, 155, 190, 235, 255):
+        task.reset(np.random.default_rng(seed))
+        check(task.sim, task.agents, np.column_stack([task.sim.true_poses[task.agents]]), task.goals)
+
+
+def test_a_scenario_that_cannot_hold_its_robots_is_refused_when_made() -> None:
+    options = ScenarioOptions(scenario="random", n_robots=60, arena_size=4.0, body=SMALL)
+    with pytest.raises(PlacementError, match="'random' scenario cannot hold 60 robot"):
+        NavigationTask(Scenario(options), TaskConfig())
