@@ -11,7 +11,6 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
-from stage_sim.cli.arguments import resolve_world
 from stage_sim.maps.body_geometry import global_poses
 from stage_sim.maps.raster import static_outline_summary
 from stage_sim.worldfile.description import Model, Pose, WorldDescription
@@ -154,7 +153,7 @@ def format_inspect(data: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    data = inspect_data(load_world(resolve_world(args.world)))
+    data = inspect_data(load_world(args.world))
     print(json.dumps(data, indent=2) if args.json else format_inspect(data))
     return 0
 

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.worldfile.bitmap_files import BitmapFiles
+from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.colors import RGBA
 from stage_sim.worldfile.description import (
     Block,
@@ -77,8 +78,12 @@ _UNIT_SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
 
 
 def load_world(path: str | Path, reader: Reader = read_text_file) -> WorldDescription:
-    """Load the world file at ``path`` with its includes and bitmaps."""
-    return _Loader(parse_world(path, reader)).load()
+    """Load the world file at ``path`` (or the bundled world of that name) with its includes and bitmaps.
+
+    A path that is not a file is looked up among the bundled worlds (``rooms`` or ``rooms.world``), as the
+    command line does; :class:`~stage_sim.worldfile.bundled.WorldNotFoundError` says what was tried.
+    """
+    return _Loader(parse_world(find_world(path), reader)).load()
 
 
 def load_world_text(text: str, path: str | Path = "world.world", reader: Reader = read_text_file) -> WorldDescription:

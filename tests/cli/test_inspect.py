@@ -83,12 +83,11 @@ def test_unknown_world_name_exits_2(capsys: pytest.CaptureFixture[str]) -> None:
 def test_bundled_world_names_are_resolved(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from stage_sim.worldfile import bundled
+    from stage_sim.worldfile.bundled import data_root
 
-    path = write_rooms(tmp_path)
-    monkeypatch.setattr(bundled, "find_world", lambda name: path if name == "rooms" else None)
+    monkeypatch.chdir(tmp_path)
     assert cli.main(["inspect", "rooms", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["world"]["path"] == str(path)
+    assert json.loads(capsys.readouterr().out)["world"]["path"] == str(data_root() / "worlds" / "rooms.world")
 
 
 def test_a_subcommand_is_required(capsys: pytest.CaptureFixture[str]) -> None:
