@@ -252,7 +252,7 @@ class StageRos(Node):
         sim = self.sim
         time = conversions.stamp(sim.sim_time_us)
         self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
-        true_velocity = fields.ground_truth_velocities(sim)
+        true_velocity = sim.true_velocities
         # A message nobody has subscribed to is neither filled nor serialised (asking DDS costs ~1.5 µs, a
         # publish 15-80 µs): with a hundred robots most topics have no reader, and lockstep runs go 2x faster.
         tf_wanted = self.tf_pub.get_subscription_count() > 0
