@@ -7,6 +7,11 @@ gets by default, how its transducers are read and whether the simulation produce
 Which sensors belong to a robot is stageros' rule (:func:`robot_sensors`): the simulated sensors that are
 *direct* children of a position model. A simulated sensor placed anywhere else is loaded but produces no
 data, and the loader says so where it is written (:func:`stray_sensor_warnings`).
+
+A new sensor type is an entry in :data:`SENSOR_KINDS` (with its reader beside :func:`ranger_sensors` in
+:mod:`stage_sim.worldfile.sensors` if it has transducers); a simulated one also needs its spec built from
+:func:`robot_sensors` in :mod:`stage_sim.sim.robots`, the readings the simulation computes each step, and
+its message and topic on the ROS side.
 """
 
 from __future__ import annotations
