@@ -24,13 +24,12 @@ sys.path.insert(0, str(REPO))
 
 from stage_sim.runs.driver import WanderDriver  # noqa: E402
 from stage_sim.sim.simulation import Simulation  # noqa: E402
-from stage_sim.worldfile.bundled import find_world  # noqa: E402
 from stage_sim.worldfile.loader import load_world  # noqa: E402
 
 
 def measure(world: str, steps: int, seed: int, profiler: cProfile.Profile | None) -> dict:
     """Time ``steps`` decisions and simulation steps of one seeded run."""
-    sim = Simulation(load_world(find_world(world)), seed=seed)
+    sim = Simulation(load_world(world), seed=seed)
     driver = WanderDriver(sim, seed)
     wander_s = step_s = 0.0
     start = time.perf_counter()

@@ -46,13 +46,12 @@ def run_seed(world: str, seed: int, minutes: float) -> dict:
 def run_core_seed(world: str, seed: int, minutes: float) -> dict:
     """The same session without ROS, in this process (:mod:`stage_sim.runs.wander_run`)."""
     from stage_sim.runs.wander_run import wander_summaries
-    from stage_sim.worldfile.bundled import find_world
     from stage_sim.worldfile.errors import WorldError
     from stage_sim.worldfile.loader import load_world
 
     start = time.monotonic()
     try:
-        description = load_world(find_world(world))
+        description = load_world(world)
     except (WorldError, FileNotFoundError, ValueError) as error:
         return {"seed": seed, "wall_s": 0.0, "returncode": 2, "error": [str(error)]}
     robots = wander_summaries(description, seed, minutes * 60)

@@ -73,11 +73,6 @@ def is_fresh(scan: Scan, sim: Simulation) -> bool:
     return scan.stamp == sim.sim_time
 
 
-def ground_truth_velocities(sim: Simulation) -> np.ndarray:
-    """The body-frame twist of the true motion per robot: zero while stalled."""
-    return np.where(sim.stalled[:, None], 0.0, sim.velocities)
-
-
 @dataclass(frozen=True)
 class Edge:
     """One TF edge ``parent → child`` at (x, y, z, yaw)."""

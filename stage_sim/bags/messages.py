@@ -56,7 +56,7 @@ class StepState:
         """Copy the state of the step just taken (cheap: small arrays and the fresh scans)."""
         return cls(
             sim.sim_time_us, sim.odometry_poses.copy(), sim.true_poses.copy(), sim.velocities.copy(),
-            fields.ground_truth_velocities(sim), sim.stalled.copy(),
+            sim.true_velocities, sim.stalled.copy(),
             tuple((i, k, *fields.scan_arrays(scan)) for i, robot_scans in enumerate(sim.scans)
                   for k, scan in enumerate(robot_scans) if fields.is_fresh(scan, sim)),
         )

@@ -8,14 +8,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Iterator
 from typing import Any
 
-from stage_sim.cli.arguments import resolve_world
 from stage_sim.maps.body_geometry import global_poses
 from stage_sim.maps.raster import static_outline_summary
-from stage_sim.worldfile.description import Model, Pose, WorldDescription
+from stage_sim.worldfile.description import Pose, WorldDescription
 from stage_sim.worldfile.loader import load_world
+from stage_sim.worldfile.sensor_kinds import robot_sensors
 
 
 def inspect_data(description: WorldDescription) -> dict[str, Any]:
@@ -42,9 +41,9 @@ def inspect_data(description: WorldDescription) -> dict[str, Any]:
             "scale": window.scale,
         }
     robots, rangers = [], []
-    robot_of: dict[int, str] = {}
+    robot_of: dict[int, str] = {}  # the robot each sensor belongs to, by the simulation's rule
     poses = global_poses(description)
-    for model, parent in _with_parents(description):
+    for model in description.walk():
         pose = poses[id(model)]
         pose = Pose(pose.x, pose.y, pose.z, _wrap(pose.yaw))
         if model.type == "position" and model.position is not None:
@@ -63,9 +62,7 @@ def inspect_data(description: WorldDescription) -> dict[str, Any]:
                     "wheelbase": pos.wheelbase,
                 }
             )
-            robot_of[id(model)] = model.name
-        elif parent is not None and id(parent) in robot_of:
-            robot_of[id(model)] = robot_of[id(parent)]
+            robot_of.update((id(sensor), model.name) for sensor in robot_sensors(model))
         if model.type == "ranger":
             rangers.append(
                 {
@@ -154,7 +151,7 @@ def format_inspect(data: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    data = inspect_data(load_world(resolve_world(args.world)))
+    data = inspect_data(load_world(args.world))
     print(json.dumps(data, indent=2) if args.json else format_inspect(data))
     return 0
 
@@ -164,18 +161,6 @@ def add_command(subparsers: Any) -> None:
     parser.add_argument("world", help="world file path, or the name of a bundled world")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(run=run)
-
-
-def _with_parents(description: WorldDescription) -> Iterator[tuple[Model, Model | None]]:
-    """Every model with its parent, in pre-order (the robot index order of stageros)."""
-
-    def visit(model: Model, parent: Model | None) -> Iterator[tuple[Model, Model | None]]:
-        yield model, parent
-        for child in model.children:
-            yield from visit(child, model)
-
-    for top in description.models:
-        yield from visit(top, None)
 
 
 def _wrap(angle: float) -> float:

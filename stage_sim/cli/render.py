@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from stage_sim.cli.arguments import count, image_path, positive, resolve_world
+from stage_sim.cli.arguments import count, image_path, positive
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
 from stage_sim.sensing.kernels import add_kernel_arguments
 
@@ -16,9 +16,8 @@ def run(args: argparse.Namespace) -> int:
     from stage_sim.rendering.recorder import Recorder
     from stage_sim.sim.simulation import Simulation
 
-    world = resolve_world(args.world)
-    sim = Simulation.from_world(world, seed=args.seed, kernels=args.kernels, threads=args.threads)
-    output = args.output or Path(f"{world.stem}.png")
+    sim = Simulation.from_world(args.world, seed=args.seed, kernels=args.kernels, threads=args.threads)
+    output = args.output or Path(f"{Path(args.world).stem}.png")
     try:
         recorder = Recorder(
             sim, output, every_s=args.record_every, fps=args.record_fps, trail_s=args.trail,

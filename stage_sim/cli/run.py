@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from stage_sim.cli.arguments import positive, resolve_world
+from stage_sim.cli.arguments import positive
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
 from stage_sim.runs.interrupts import stop_requests
 from stage_sim.sensing.kernels import add_kernel_arguments
@@ -44,7 +44,7 @@ def _run(args: argparse.Namespace) -> int:
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
-    description = load_world(resolve_world(args.world))
+    description = load_world(args.world)
     speedup = description.settings.speedup if args.speedup is None else args.speedup
     threads = threads_for_run(args.threads, speedup)
     sim = Simulation(description, seed=args.seed, kernels=args.kernels, threads=threads)

@@ -13,7 +13,6 @@ import sys
 import threading
 from typing import Any
 
-from stage_sim.cli.arguments import resolve_world
 from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.view.options import add_view_arguments
 
@@ -27,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
     from stage_sim.view import LiveView, PacedLoop, view_settings
     from stage_sim.worldfile.loader import load_world
 
-    description = load_world(resolve_world(args.world))
+    description = load_world(args.world)
     speedup = description.settings.speedup if args.speedup is None else args.speedup
     sim = Simulation(description, seed=args.seed, watchdog_timeout=args.watchdog, kernels=args.kernels,
                      threads=threads_for_run(args.threads, speedup))

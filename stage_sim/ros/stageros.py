@@ -39,7 +39,6 @@ from stage_sim.ros import conversions
 from stage_sim.ros.rival_publishers import RivalPublishers
 from stage_sim.sensing.kernels import threads_for_run
 from stage_sim.sim.simulation import Simulation
-from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.loader import load_world
 
 # Commands beyond this magnitude (m/s or rad/s) are treated as garbage, not as "go very fast".
@@ -89,7 +88,7 @@ class StageRos(Node):
         world_param = self.declare_parameter("world_file", str(world) if world is not None else "").value
         if not world_param:
             raise ValueError("no world given: pass WORLD on the command line or set the 'world_file' parameter")
-        description = load_world(find_world(world_param))
+        description = load_world(world_param)
         self.world_path = description.path
         speedup_default = description.settings.speedup if speedup is None else speedup
         self.speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
@@ -253,7 +252,7 @@ class StageRos(Node):
         sim = self.sim
         time = conversions.stamp(sim.sim_time_us)
         self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
-        true_velocity = fields.ground_truth_velocities(sim)
+        true_velocity = sim.true_velocities
         # A message nobody has subscribed to is neither filled nor serialised (asking DDS costs ~1.5 µs, a
         # publish 15-80 µs): with a hundred robots most topics have no reader, and lockstep runs go 2x faster.
         tf_wanted = self.tf_pub.get_subscription_count() > 0

@@ -2,8 +2,9 @@
 
 A robot is a position model (stageros' rule: every position model, indexed in pre-order DFS). Its body is
 the outline of every block in its subtree (the robot's own blocks and those of attached models such as
-the laser housing), expressed in the robot frame. Its rangers are the ranger models whose *direct* parent
-is the position model, one scan per ranger from its first sensor, as stageros publishes them.
+the laser housing), expressed in the robot frame. Its rangers are its rangers by stageros' rule
+(:func:`~stage_sim.worldfile.sensor_kinds.robot_sensors`: direct children only), one scan per ranger from its
+first sensor, as stageros publishes them.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.drives import DRIVES, Drive
 from stage_sim.worldfile.description import Model, Pose, PositionSettings, Sensor, WorldDescription, WorldWarning
 from stage_sim.worldfile.errors import SourceLocation
+from stage_sim.worldfile.sensor_kinds import robot_sensors
 
 
 @dataclass(frozen=True)
@@ -122,8 +124,8 @@ def _rangers(
 ) -> list[RangerSpec]:
     """The robot's rangers; those with several sensors are noted in ``several`` (their first is simulated)."""
     rangers = []
-    for child in robot.children:
-        if child.type != "ranger" or not child.sensors:
+    for child in robot_sensors(robot, "ranger"):
+        if not child.sensors:
             continue
         if len(child.sensors) > 1:
             several.setdefault(child.location, []).append(

@@ -224,6 +224,12 @@ class Simulation:
         return self.interval_us / MICROSECONDS
 
     @property
+    def true_velocities(self) -> np.ndarray:
+        """The body-frame twist of each robot's true motion: its velocity, zero while stalled (the command stands,
+        the body does not move)."""
+        return np.where(self.stalled[:, None], 0.0, self.velocities)
+
+    @property
     def scans(self) -> list[list[Scan]]:
         """Latest scan of every ranger, per robot (``scans[robot][ranger]``)."""
         return self._sensing.latest

@@ -63,6 +63,7 @@ class FrameSampler:
             "poses": np.round(sim.true_poses, 5).tolist(),
             "odometry": np.round(sim.odometry_poses, 5).tolist(),
             "velocities": np.round(sim.velocities, 4).tolist(),
+            "true_velocities": np.round(sim.true_velocities, 4).tolist(),
             "stalled": sim.stalled.tolist(),
             "ranges": ranges,
         }

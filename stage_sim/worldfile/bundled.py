@@ -12,6 +12,8 @@ import site
 import sys
 from pathlib import Path
 
+from stage_sim.worldfile.errors import WorldError
+
 PACKAGE = "stage_sim"
 WORLD_SUFFIX = ".world"
 
@@ -52,19 +54,25 @@ def bundled_worlds() -> list[str]:
     return sorted(p.name for p in worlds.iterdir() if p.is_file() and p.suffix == WORLD_SUFFIX)
 
 
+class WorldNotFoundError(WorldError, FileNotFoundError):
+    """Neither a file nor a bundled world: a world error for the CLI (exit 2), a missing file for Python callers."""
+
+
 def find_world(name_or_path: str | Path) -> Path:
     """Resolve what a user typed: an existing file as given, else a bundled world by name or stem.
 
     ``rooms.world`` and ``rooms`` both find the bundled rooms world from any working directory. Raises
-    FileNotFoundError naming the bundled worlds when nothing matches.
+    :class:`WorldNotFoundError` saying what was tried and naming the bundled worlds when nothing matches.
     """
     given = Path(name_or_path)
     if given.is_file():
         return given
     available = bundled_worlds()
-    if given.name == str(name_or_path):
+    is_name = given.name == str(name_or_path)
+    if is_name:
         for candidate in (given.name, given.name + WORLD_SUFFIX):
             if candidate in available:
                 return data_root() / "worlds" / candidate
     listing = ", ".join(available) if available else "none installed"
-    raise FileNotFoundError(f"world file not found: {name_or_path} (bundled worlds: {listing})")
+    tried = "no such file, nor a bundled world of that name" if is_name else "no such file"
+    raise WorldNotFoundError(f"world file not found: {name_or_path} ({tried}; bundled worlds: {listing})")

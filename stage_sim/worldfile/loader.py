@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.worldfile.bitmap_files import BitmapFiles
-from stage_sim.worldfile.colors import RGBA
+from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.description import (
     Block,
     Model,
@@ -46,7 +46,8 @@ from stage_sim.worldfile.keys import (
     Units,
     Warnings,
 )
-from stage_sim.worldfile.sensors import position_settings, ranger_sensors, read_sensor
+from stage_sim.worldfile.sensor_kinds import ROBOT_TYPE, SENSOR_KINDS, SENSOR_OF_WORLD_TYPE, stray_sensor_warnings
+from stage_sim.worldfile.sensors import position_settings, read_sensor
 from stage_sim.worldfile.syntax import (
     Define,
     Entity,
@@ -59,26 +60,26 @@ from stage_sim.worldfile.syntax import (
 )
 
 MODEL_TYPES = frozenset(
-    {"model", "position", "ranger", "camera", "fiducial", "blobfinder", "gripper", "actuator", "bumper",
-     "blinkenlight", "lightindicator", "wifi"}
+    {"model", ROBOT_TYPE, "gripper", "actuator", "blinkenlight", "lightindicator", "wifi", *SENSOR_KINDS}
 )  # fmt: skip
 """Stage 4's model types, and Stage 3's ``wifi`` (its wifi worlds are still in Stage's tree)."""
-NOT_SIMULATED = MODEL_TYPES - {"model", "position", "ranger"}
+NOT_SIMULATED = MODEL_TYPES - {"model", ROBOT_TYPE} - {kind.type for kind in SENSOR_KINDS.values() if kind.simulated}
 """Read (bodies, names, poses) and ignored with one warning per type and world; they produce no data."""
-BODY_TYPES = frozenset({"model", "position"})
+BODY_TYPES = frozenset({"model", ROBOT_TYPE})
 """Types that get Stage's default unit-square body when they have neither ``block`` nor ``bitmap``."""
-BUILTIN_TYPES = MODEL_TYPES | {"window", "block", "sensor", "laser"}
+BUILTIN_TYPES = MODEL_TYPES | {"window", "block", "sensor", *SENSOR_OF_WORLD_TYPE}
 MAX_MODELS = 100_000
 MAX_DEPTH = 100
-
-_DEFAULT_SIZES = {"ranger": (0.15, 0.15, 0.2), "camera": (0.1, 0.07, 0.05)}
-_DEFAULT_COLORS: dict[str, RGBA] = {"ranger": (0.0, 0.0, 139 / 255, 1.0)}
 _UNIT_SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
 
 
 def load_world(path: str | Path, reader: Reader = read_text_file) -> WorldDescription:
-    """Load the world file at ``path`` with its includes and bitmaps."""
-    return _Loader(parse_world(path, reader)).load()
+    """Load the world file at ``path`` (or the bundled world of that name) with its includes and bitmaps.
+
+    A path that is not a file is looked up among the bundled worlds (``rooms`` or ``rooms.world``), as the
+    command line does; :class:`~stage_sim.worldfile.bundled.WorldNotFoundError` says what was tried.
+    """
+    return _Loader(parse_world(find_world(path), reader)).load()
 
 
 def load_world_text(text: str, path: str | Path = "world.world", reader: Reader = read_text_file) -> WorldDescription:
@@ -146,6 +147,8 @@ class _Loader:
         for kind, locations in self.not_simulated.items():
             more = f"; {len(locations)} in this world, the first here" if len(locations) > 1 else ""
             self.warnings.add(f"'{kind}' models are not simulated (loaded, but produce no data){more}", locations[0])
+        for warning in stray_sensor_warnings(models):
+            self.warnings.add(warning.message, warning.location)
         return WorldDescription(self.syntax.path, settings, models, self.warnings.items)
 
     def _settings(self, world: Properties, window: WindowSettings | None) -> WorldSettings:
@@ -211,8 +214,8 @@ class _Loader:
                 found="more models or deeper nesting",
                 expected=f"at most {MAX_MODELS} models nested at most {MAX_DEPTH} deep",
             )
-        laser = instance.type == "laser"
-        kind = "ranger" if laser else instance.type
+        sensor_kind = SENSOR_OF_WORLD_TYPE.get(instance.type)
+        kind = sensor_kind.type if sensor_kind is not None else instance.type
         props = Properties(instance.properties, self.units, self.warnings, MODEL_ALIASES)
         token = f"{kind}:{counters[kind]}"
         counters[kind] += 1
@@ -223,9 +226,9 @@ class _Loader:
         model = Model(type=kind, name=name, location=instance.location)
         self._model_keys(model, props, top_level=parent is None)
         sensors = self._children(model, instance, depth)
-        if kind == "ranger":
-            model.sensors = ranger_sensors(props, sensors, laser, instance.location)
-        if kind == "position":
+        if sensor_kind is not None and sensor_kind.read is not None:
+            model.sensors = sensor_kind.read(props, sensors, instance.type, instance.location)
+        if kind == ROBOT_TYPE:
             model.position = position_settings(props)
         if kind in BODY_TYPES and not model.blocks and model.bitmap is None:
             model.blocks.append(Block(_UNIT_SQUARE.copy(), (0.0, 1.0), None))
@@ -238,13 +241,14 @@ class _Loader:
     def _model_keys(self, model: Model, props: Properties, top_level: bool) -> None:
         """The keys every model type has (spec §8.5)."""
         model.pose = props.pose("pose", Pose()) or Pose()
-        default_size = _DEFAULT_SIZES.get(model.type, (0.4, 0.4, 1.0))
+        sensor_kind = SENSOR_KINDS.get(model.type)
+        default_size = (sensor_kind and sensor_kind.size) or (0.4, 0.4, 1.0)
         size = props.size(default_size[2])
         if size is not None:
             props.require(min(size) >= 0, "size", list(size), "sizes >= 0")
         model.size = size or default_size
         model.origin = props.pose("origin", Pose()) or Pose()
-        model.color = props.color(_DEFAULT_COLORS.get(model.type, (1.0, 0.0, 0.0, 1.0)))
+        model.color = props.color((sensor_kind and sensor_kind.color) or (1.0, 0.0, 0.0, 1.0))
         model.boundary = props.flag("boundary", False)
         model.obstacle_return = props.flag("obstacle_return", True)
         model.ranger_return = props.number("ranger_return", 1.0)
@@ -274,7 +278,7 @@ class _Loader:
             if child.type == "block":
                 model.blocks.append(self._block(child))
             elif child.type == "sensor":
-                if model.type != "ranger":
+                if model.type not in SENSOR_KINDS or SENSOR_KINDS[model.type].read is None:
                     raise WorldError(
                         "'sensor' outside a ranger",
                         child.location,

@@ -62,8 +62,8 @@ def _beam_fields(props: Properties) -> dict:
     }
 
 
-def ranger_sensors(props: Properties, sensors: list[Sensor], laser: bool, where: SourceLocation) -> list[Sensor]:
-    """The transducers of a ranger, including the two Stage 3 forms read with a warning.
+def ranger_sensors(props: Properties, sensors: list[Sensor], written: str, where: SourceLocation) -> list[Sensor]:
+    """The transducers of a ranger written as type ``written``, including the two Stage 3 forms read with a warning.
 
     * Stage 3 ``laser( samples range_max fov )`` (Stage 4 refuses the type): one sensor with the laser's
       keys, defaults 180 samples, 8 m, 180°; ``sensor( )`` blocks, if any, take precedence.
@@ -72,7 +72,7 @@ def ranger_sensors(props: Properties, sensors: list[Sensor], laser: bool, where:
       the author meant. With ``sensor( )`` blocks present they are ignored, as in Stage 4.
     """
     warnings = props.warnings
-    if laser:
+    if written == "laser":
         count = props.integer("samples", LASER_SAMPLES)
         range_min = props.length("range_min", 0.0)
         range_max = props.length("range_max", LASER_RANGE_MAX)

@@ -21,6 +21,34 @@ def run_json(world: Path, capsys: pytest.CaptureFixture[str]) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+NESTED_LASER = """position(
+  name "bot"
+  ranger( sensor( samples 3 ) )
+  model(
+    name "mast"
+    ranger( name "high" sensor( samples 5 ) )
+  )
+)
+ranger( name "alone" sensor( samples 7 ) )
+"""
+
+
+def test_a_sensor_the_simulation_ignores_has_no_robot_and_a_located_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    world = tmp_path / "nested.world"
+    world.write_text(NESTED_LASER)
+    data = run_json(world, capsys)
+    assert {r["name"]: r["robot"] for r in data["rangers"]} == {"bot.ranger:0": "bot", "high": None, "alone": None}
+    located = {(w["line"], w["column"]): w["message"] for w in data["warnings"] if "is not simulated" in w["message"]}
+    assert located.keys() == {(6, 5), (9, 1)}
+    assert located[(6, 5)].startswith("ranger 'high' is not simulated: it sits on model 'mast'")
+    assert "only the direct children of a position model" in located[(6, 5)]
+    assert located[(9, 1)].startswith("ranger 'alone' is not simulated: it sits at the top level")
+    assert cli.main(["inspect", str(world)]) == 0
+    assert f"{world}:6:5: ranger 'high' is not simulated" in capsys.readouterr().out
+
+
 def test_json_report_of_rooms(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     data = run_json(write_rooms(tmp_path), capsys)
     world = data["world"]
@@ -83,12 +111,11 @@ def test_unknown_world_name_exits_2(capsys: pytest.CaptureFixture[str]) -> None:
 def test_bundled_world_names_are_resolved(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from stage_sim.worldfile import bundled
+    from stage_sim.worldfile.bundled import data_root
 
-    path = write_rooms(tmp_path)
-    monkeypatch.setattr(bundled, "find_world", lambda name: path if name == "rooms" else None)
+    monkeypatch.chdir(tmp_path)
     assert cli.main(["inspect", "rooms", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["world"]["path"] == str(path)
+    assert json.loads(capsys.readouterr().out)["world"]["path"] == str(data_root() / "worlds" / "rooms.world")
 
 
 def test_a_subcommand_is_required(capsys: pytest.CaptureFixture[str]) -> None:

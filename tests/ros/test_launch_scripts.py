@@ -146,11 +146,10 @@ def test_bag_records_the_session_and_the_summaries_still_print(tmp_path: Path) -
 def test_a_lockstep_session_gives_what_the_core_run_of_the_sweep_gives(tmp_path: Path) -> None:
     """``wander_sweep.py --core`` stands for the ROS sessions: same seed, same summaries, to the last digit."""
     from stage_sim.runs.wander_run import wander_summaries
-    from stage_sim.worldfile.bundled import find_world
     from stage_sim.worldfile.loader import load_world
 
     result = run_script("multi_reactive.py", "--duration", "30", "--speedup", "0", "--seed", "4", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    core = wander_summaries(load_world(find_world("multi_robots.world")), 4, 30.0)
+    core = wander_summaries(load_world("multi_robots.world"), 4, 30.0)
     assert summaries(result.stdout) == core
     assert all(robot["distance_m"] > 5 for robot in core)

@@ -21,7 +21,6 @@ from std_msgs.msg import Bool
 from stage_sim.ros.stageros import StageRos
 from stage_sim.ros.wander import Wander
 from stage_sim.wander.reactive import BUMPED_S
-from stage_sim.worldfile.bundled import find_world
 from tests.ros.helpers import spin_until
 from tests.wander.test_reactive import POCKET_SIDES, scan_of_segments
 
@@ -133,7 +132,7 @@ def test_a_stall_on_the_stall_topic_ends_the_reversing_that_caused_it(
 @pytest.mark.slow
 def test_console_script_drives_and_stops_its_robot_on_ctrl_c(ros_context, executor, tmp_path) -> None:
     # No watchdog: only the node's own zero twist at exit can stop the robot.
-    stage = StageRos(str(find_world("rooms.world")), speedup=2.0, seed=3, context=ros_context,
+    stage = StageRos("rooms.world", speedup=2.0, seed=3, context=ros_context,
                      parameter_overrides=[Parameter("base_watchdog_timeout", value=0.0)])
     probe = Node("probe", context=ros_context)
     executor.add_node(stage)

@@ -9,7 +9,6 @@ import pytest
 
 from stage_sim.runs.interrupts import sigterm_interrupts, stop_requests
 from stage_sim.sim.simulation import Simulation
-from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.loader import load_world
 
 
@@ -17,7 +16,7 @@ from stage_sim.worldfile.loader import load_world
 def test_a_signal_during_a_step_only_asks_the_loop_to_stop(number: int) -> None:
     """A KeyboardInterrupt raised inside a step can land in a numba kernel's callback (reported as a
     SystemError, `stage_sim run` then died with a traceback) or inside a lock (the run hung at exit)."""
-    sim = Simulation(load_world(find_world("multi_robots.world")), seed=1)
+    sim = Simulation(load_world("multi_robots.world"), seed=1)
     steps = 0
     before = signal.getsignal(number)  # whatever the test process has (ignored under nohup, rclpy's, ...)
     with stop_requests() as stop:

@@ -236,3 +236,49 @@ def test_a_world_with_several_robots_and_the_wanderer_runs_in_the_page(browser) 
     finally:
         context.close()
         running.close()
+
+
+FACING_A_WALL = """resolution 0.02
+model( size [4 0.2 1] pose [0 -0.45 0 0] color "gray" )
+position( name "bot" size [0.4 0.4 0.2] pose [0 0 0 -90] color "red" )
+"""
+
+
+def test_the_panel_beside_the_map_shows_no_motion_while_stalled_and_the_robot_carries_its_name(
+    browser, tmp_path
+) -> None:
+    world = tmp_path / "wall.world"
+    world.write_text(FACING_A_WALL)
+    running = serve(world=world)
+    context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1)
+    try:
+        tab = context.new_page()
+        tab.goto(running.url)
+        tab.wait_for_function("window.stageView && stageView.state.drawnFrame !== null")
+        tab.locator("#world").focus()
+        tab.keyboard.down("i")  # forward, into the wall just ahead
+        tab.wait_for_function("stageView.state.drawnFrame.stalled[0] && !document.getElementById('selection').hidden")
+        text = tab.locator("#selection").inner_text()
+        tab.keyboard.up("i")
+        assert "velocity    0.00  0.00 m/s   0.00 rad/s" in text
+        assert "commanded   0.50  0.00 m/s   0.00 rad/s" in text and "STALLED" in text
+
+        panel, canvas = tab.locator("#selection").bounding_box(), tab.locator("#world").bounding_box()
+        assert panel["x"] >= canvas["x"] + canvas["width"]  # beside the map, not over it
+        x0, y0, x1, y1 = tab.evaluate("stageView.state.scene.bounds")
+        for corner in ((x0, y0), (x1, y1)):
+            cx, cy = tab.evaluate("([x, y]) => stageView.worldToCanvas(x, y)", list(corner))
+            assert 0 <= cx <= canvas["width"] and 0 <= cy <= canvas["height"]
+
+        # The name, up and to the right of the body: dark text where the floor is otherwise light.
+        pose = running.sim.true_poses[0]
+        cx, cy = tab.evaluate("([x, y]) => stageView.worldToCanvas(x, y)", [float(pose[0]), float(pose[1])])
+        ring = (running.sim.robots[0].radius + 0.06) * tab.evaluate("stageView.state.camera.scale") + 2
+        left, bottom = round(cx + 0.75 * ring), round(cy - 0.75 * ring)
+        image = np.asarray(Image.open(io.BytesIO(tab.locator("#world").screenshot())).convert("RGB")).astype(int)
+        label = image[bottom - 14:bottom, left:left + 30]
+        assert np.count_nonzero(label.max(axis=2) < 80) > 10
+        assert tab.evaluate("stageView.state.scene.robots[0].name") == "bot"
+    finally:
+        context.close()
+        running.close()

@@ -9,6 +9,8 @@ import pytest
 
 from stage_sim.worldfile.bitmap import load_stage_bitmap, occupied_bounding_box
 from stage_sim.worldfile.bundled import bundled_worlds, data_root, find_world
+from stage_sim.worldfile.errors import WorldError
+from stage_sim.worldfile.loader import load_world
 from stage_sim.worldfile.map_yaml import load_map_yaml
 
 RES = 0.05
@@ -120,6 +122,29 @@ def test_find_world_unknown_lists_the_bundled_worlds(tmp_path: Path, monkeypatch
         find_world("nowhere.world")
     with pytest.raises(FileNotFoundError):
         find_world("some/dir/rooms.world")  # a path with folders is never a bundled name
+
+
+def test_load_world_finds_a_bundled_world_by_name(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    for name in ("rooms.world", "rooms"):
+        description = load_world(name)
+        assert description.path == data_root() / "worlds" / "rooms.world"
+        assert description.robots()
+
+
+def test_load_world_prefers_a_file_of_that_name(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "rooms.world").write_text('position( name "mine" )\n')
+    assert [robot.name for robot in load_world("rooms.world").robots()] == ["mine"]
+
+
+def test_load_world_of_nothing_says_what_it_tried(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(WorldError, match=r"nowhere\.world \(no such file, nor a bundled world of that name; "
+                       r"bundled worlds: .*rooms\.world"):
+        load_world("nowhere.world")
+    with pytest.raises(FileNotFoundError, match=r"some/dir/rooms\.world \(no such file; bundled worlds"):
+        load_world("some/dir/rooms.world")
 
 
 @pytest.mark.parametrize("name", sorted(MAPS))

@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from stage_sim.worldfile import bitmap_files, syntax
-from stage_sim.worldfile.bundled import bundled_worlds, find_world
+from stage_sim.worldfile.bundled import bundled_worlds
 from stage_sim.worldfile.errors import SourceLocation, WorldError
 from stage_sim.worldfile.loader import load_world
 from stage_sim.worldfile.search_path import candidate_paths
@@ -124,4 +124,4 @@ def test_bundled_worlds_load_by_stages_rule_alone(world: str, monkeypatch: pytes
 
     monkeypatch.setattr(syntax, "candidate_paths", stage_place_only)
     monkeypatch.setattr(bitmap_files, "candidate_paths", stage_place_only)
-    assert load_world(find_world(world)).models
+    assert load_world(world).models

@@ -588,9 +588,10 @@ def test_ranger_level_keys_become_the_single_sensor_with_a_warning() -> None:
     (sensor,) = world.models[0].sensors
     assert sensor.range_max == 8 and sensor.fov == pytest.approx(math.pi) and sensor.samples == 181
     assert sensor.noise == (0.1, 0, 0)
-    (warning,) = world.warnings
+    (warning, stray) = world.warnings  # a ranger on no robot is also said to produce no scans
     assert "single sensor" in warning.message and "outside sensor( )" in warning.message
     assert warning.location == SourceLocation("/virtual/w.world", 1, 9)
+    assert "is not simulated: it sits at the top level" in stray.message
 
 
 def test_ranger_level_keys_next_to_sensors_are_ignored() -> None:
@@ -636,7 +637,8 @@ def test_stage3_keys_inside_rangers_and_sensors_are_ignored(key: str) -> None:
     world = load(f"ranger( {key} sensor( {key} ) )")
     assert world.models[0].sensors == [Sensor()]
     name = key.split()[0]
-    assert [m.startswith(f"Stage 3 key '{name}' ignored") for m in messages(world)] == [True, True]
+    assert [m.startswith(f"Stage 3 key '{name}' ignored") for m in messages(world)] == [True, True, False]
+    assert messages(world)[2].startswith("ranger 'ranger:0' is not simulated: it sits at the top level")
 
 
 def test_size3_origin3_and_interval_real() -> None:

@@ -1,8 +1,10 @@
-// Drawing one picture of the world: map, grid with metre labels, trails, laser data, robots, selection.
+// Drawing one picture of the world: map, grid with metre labels, trails, laser data, robots and their names.
 
 const GRID_MIN_PX = 40;     // grid lines at least this far apart on screen
 const STALL = "#d00000";
 const SELECT = "#1a7f37";
+const NAME_FONT = "12px system-ui, sans-serif";
+const NAME_OFFSET = 0.75;   // of the stall ring's radius, along each axis: just outside the ring's corner
 
 export function decodeRanges(base64) {
   const bytes = Uint8Array.from(atob(base64), (c) => c.charCodeAt(0));
@@ -154,8 +156,22 @@ function drawRobots(ctx, camera, scene, frame, selected) {
     const ring = (robot.radius + 0.06) * camera.scale + 2;
     if (frame.stalled[i]) circle(ctx, cx, cy, ring, STALL, 3, []);
     if (i === selected) circle(ctx, cx, cy, ring + 4, SELECT, 2, [6, 4]);
+    label(ctx, robot.name, cx + ring * NAME_OFFSET, cy - ring * NAME_OFFSET);
   });
   ctx.restore();
+}
+
+// A robot's name (its ROS prefix or model name, as the panel and the messages call it), up and to the right
+// of the body, clear of its rings, with a white halo so it reads on walls and floor alike.
+function label(ctx, text, x, y) {
+  ctx.font = NAME_FONT;
+  ctx.textBaseline = "bottom";
+  ctx.lineJoin = "round";
+  ctx.lineWidth = 3;
+  ctx.strokeStyle = "rgba(255, 255, 255, 0.85)";
+  ctx.strokeText(text, x, y);
+  ctx.fillStyle = "#111";
+  ctx.fillText(text, x, y);
 }
 
 function circle(ctx, x, y, radius, color, width, dash) {

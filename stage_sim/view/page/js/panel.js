@@ -24,15 +24,16 @@ export function showSelection(element, state, input) {
     element.hidden = true;
     return;
   }
-  const [vx, vy, va] = frame.velocities[selected];
   const stalled = frame.stalled[selected];
+  const twist = ([vx, vy, va]) => `${fixed(vx, 2)} ${fixed(vy, 2)} m/s  ${fixed(va, 2)} rad/s`;
   element.hidden = false;
   element.innerHTML = "";
   const lines = [
     scene.robots[selected].name,
     `true pose  ${pose(frame.poses[selected])}`,
     `odometry   ${pose(frame.odometry[selected])}`,
-    `velocity   ${fixed(vx, 2)} ${fixed(vy, 2)} m/s  ${fixed(va, 2)} rad/s`,
+    `velocity   ${twist(frame.true_velocities[selected])}`,
+    `commanded  ${twist(frame.velocities[selected])}`,
     `keys drive at ${input.speed.toFixed(2)} m/s, ${input.turn.toFixed(2)} rad/s`,
   ];
   for (const line of lines) element.append(line, "\n");
