@@ -1,4 +1,4 @@
-"""``make_caster``: the ray caster of the chosen implementation (see :mod:`stage_sim.sensing.kernels`)."""
+"""``make_caster``: the ray caster of the chosen implementation (see :mod:`stage_sim.backend`)."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from stage_sim.backend import resolve_kernels
 from stage_sim.maps.tiles import TileLayer
-from stage_sim.sensing.kernels import resolve_kernels
 from stage_sim.sensing.raycast import GridRayCaster
 
 if TYPE_CHECKING:

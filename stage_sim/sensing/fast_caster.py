@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from stage_sim.backend import announce_compilation, set_threads
 from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing import traversal
-from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
 from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sensing.stage_walk import ray_arguments, static_layer

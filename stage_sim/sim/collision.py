@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stage_sim.backend import set_threads
 from stage_sim.maps.polygon_raster import point_cells
 from stage_sim.maps.tiles import TileLayer, unique_sorted
-from stage_sim.sensing.kernels import set_threads
 from stage_sim.sim.kinematics import integrate
 
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few

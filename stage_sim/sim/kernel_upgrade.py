@@ -25,7 +25,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from stage_sim.sensing.kernels import KERNELS_ENV, numba_available
+from stage_sim.backend import KERNELS_ENV, numba_available
 
 log = logging.getLogger("stage_sim")
 _LOADED = {"numba": False}

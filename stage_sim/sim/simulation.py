@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from stage_sim.backend import resolve_kernels, resolve_threads
 from stage_sim.maps.raster import StaticRaster, build_static_raster
-from stage_sim.sensing.kernels import resolve_kernels, resolve_threads
 from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, mark_numba_loaded, upgrade_wanted
 from stage_sim.sim.kinematics import body_velocity
@@ -55,7 +55,7 @@ class Simulation:
     ) -> None:
         """``kernels``: "numba" or "numpy" (identical results; default numba, ``$STAGE_SIM_KERNELS``);
         ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
-        ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.sensing.kernels`."""
+        ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.backend`."""
         self.description = description
         self.warnings: list[WorldWarning] = list(description.warnings)
         self.robots: list[RobotSpec] = build_robots(description, self.warnings)

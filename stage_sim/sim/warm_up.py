@@ -7,8 +7,8 @@ import logging
 
 import numpy as np
 
+from stage_sim.backend import numba_available
 from stage_sim.sensing.casters import make_caster
-from stage_sim.sensing.kernels import numba_available
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
 
