@@ -94,7 +94,9 @@ class Contact(Protocol):
 
 class CollisionChecker:
     """Decides which robot moves to accept, given the static cells that block each robot's height band: the
-    numpy reference of the :class:`Contact` role (the compiled backend overrides the marked hooks)."""
+    numpy reference of the :class:`Contact` role. The compiled backend overrides its hooks, with the same
+    answers: ``_body_cells``, ``_moves``, ``_contains``, ``_replace_cells``, ``_close_to_another``, ``_close_to``
+    and ``_clashes``."""
 
     def __init__(
         self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
@@ -156,8 +158,6 @@ class CollisionChecker:
     def point_cells(self, poses: np.ndarray) -> np.ndarray:
         """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
         return self._body_cells(self.bodies.points, self.bodies.owner, poses)
-
-    # -- the hooks the compiled backend overrides (same answers) -------------------------------------------
 
     def _body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
