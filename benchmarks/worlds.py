@@ -135,7 +135,7 @@ def world_text(name: str, folder: Path, rl_range: float = RL_RANGE) -> str:
 
 def measure(name: str, seconds: float, kernels: str, threads: int, rl_range: float) -> dict:
     """Load the world, drive every robot in a circle for ``seconds`` of sim time, report."""
-    from stage_sim.sensing.kernels import numba_available
+    from stage_sim.backend import numba_available
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world_text
 

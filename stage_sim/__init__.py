@@ -10,6 +10,7 @@ Dependencies point one way only, top to bottom (enforced by import-linter, ``.im
     sensing                                     ray casting on the grid, Stage's walk
     maps                                        the static world rasterised
     worldfile                                   .world/.inc/bitmap/YAML → WorldDescription
+    backend                                     kernel settings: numba or numpy, threads, numba's cache
 
 The names below are the public API, imported on first use so that ``import stage_sim`` stays cheap.
 """

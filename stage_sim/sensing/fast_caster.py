@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from stage_sim.backend import announce_compilation, set_threads
 from stage_sim.maps.tiles import TileLayer
 from stage_sim.sensing import traversal
-from stage_sim.sensing.kernels import announce_compilation, set_threads
 from stage_sim.sensing.raycast import CastResult
-from stage_sim.sensing.robot_layer import RobotLayer
+from stage_sim.sensing.robot_layer import CompiledRobotLayer
 from stage_sim.sensing.stage_walk import ray_arguments, static_layer
 from stage_sim.sensing.stop_map import StopMap
 
@@ -31,8 +31,6 @@ class NumbaRayCaster:
 
     ``occupied``: the layer in tiles, or a dense (H, W) grid; ``blocks`` (dense only): cells holding a
     block of any model at any height (they decide Stage's empty regions), default ``occupied``."""
-
-    kernels = "numba"
 
     def __init__(self, occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float],
                  threads: int = 1, blocks: np.ndarray | None = None):
@@ -53,9 +51,9 @@ class NumbaRayCaster:
                            np.zeros((1, 1), dtype=np.uint32), np.zeros((1, 1), dtype=np.uint32),
                            np.zeros(1, dtype=np.uint32), np.zeros(1, dtype=np.uint32), np.full(1, -1, dtype=np.int32))
 
-    def robot_layer(self) -> RobotLayer:
+    def robot_layer(self) -> CompiledRobotLayer:
         """An empty robot layer for this caster's grid."""
-        return RobotLayer(self._grid, compiled=True)
+        return CompiledRobotLayer(self._grid)
 
     def cast(
         self,
@@ -63,7 +61,7 @@ class NumbaRayCaster:
         angles: np.ndarray,
         max_ranges: np.ndarray | float,
         owners: np.ndarray | None = None,
-        robots: RobotLayer | None = None,
+        robots: CompiledRobotLayer | None = None,
     ) -> CastResult:
         """Cast N rays; ``owners[i]`` is the robot that ray i belongs to (−1: none)."""
         xy, ang, rmax, own = ray_arguments(origins_xy, angles, max_ranges, owners)
@@ -76,7 +74,7 @@ class NumbaRayCaster:
 
     def cast_into(
         self, origins: np.ndarray, origin_of: np.ndarray, heading: np.ndarray, local: np.ndarray, rmax: np.ndarray,
-        owners: np.ndarray, robots: RobotLayer | None, out_at: np.ndarray, out: np.ndarray,
+        owners: np.ndarray, robots: CompiledRobotLayer | None, out_at: np.ndarray, out: np.ndarray,
         jitter: np.ndarray = _NONE, trig: tuple[np.ndarray, np.ndarray, np.ndarray] = (_NONE, _NONE, _NONE),
     ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`cast` as the simulation calls it, with no copies: ray i starts at ``origins[origin_of[i]]``

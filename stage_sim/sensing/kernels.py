@@ -1,73 +1,12 @@
-"""Which implementation runs the per-step hot paths, on how many threads, and where numba caches them.
-
-Two implementations exist and give identical answers (``tests/sensing``, ``tests/sim``):
-
-* ``"numba"`` (default): compiled kernels, :mod:`stage_sim.sensing.traversal` and
-  :mod:`stage_sim.sim.collision_kernels`; parallel over rays when ``threads > 1``.
-* ``"numpy"``: the vectorised reference (:mod:`stage_sim.sensing.raycast`, :mod:`stage_sim.sim.collision`).
-
-Choice, strongest first: the explicit argument (``Simulation(kernels=...)``, ``--kernels``), the
-environment variable ``STAGE_SIM_KERNELS``, the default ``numba``. If numba cannot be imported the
-numpy path runs after a one-line warning. A :class:`~stage_sim.sim.simulation.Simulation` whose kernels
-nobody chose reaches the default through :mod:`stage_sim.sim.kernel_upgrade` (numpy first, numba once it
-has loaded in the background). Threads likewise: argument, ``STAGE_SIM_THREADS``, 1.
-
-Compiled kernels are cached on disk (``cache=True``) next to the package, or, when that folder is not
-writable (a system-wide install), in ``~/.cache/stage_sim`` (``NUMBA_CACHE_DIR`` when set wins). The
-first compilation logs "compiling simulation kernels, once"; ``make setup`` runs
-:mod:`stage_sim.sim.warm_up` to fill the cache.
-"""
+"""The command-line kernel options and the threads of a paced run (the settings themselves:
+:mod:`stage_sim.backend`)."""
 
 from __future__ import annotations
 
 import argparse
-import logging
 import os
-import sys
-import warnings
-from functools import cache
-from pathlib import Path
 
-KERNELS = ("numba", "numpy")
-KERNELS_ENV = "STAGE_SIM_KERNELS"
-THREADS_ENV = "STAGE_SIM_THREADS"
-_PACKAGE = Path(__file__).resolve().parents[1]
-
-log = logging.getLogger("stage_sim")
-
-
-def resolve_kernels(requested: str | None = None) -> str:
-    """``"numba"`` or ``"numpy"``: the argument, else ``$STAGE_SIM_KERNELS``, else numba (if it imports)."""
-    choice = requested or os.environ.get(KERNELS_ENV) or "numba"
-    if choice not in KERNELS:
-        raise ValueError(f"kernels must be one of {', '.join(KERNELS)}, not {choice!r}")
-    if choice == "numba" and not numba_available():
-        return "numpy"
-    return choice
-
-
-def resolve_threads(requested: int | None = None, default: int = 1) -> int:
-    """Threads for the kernels: the argument, else ``$STAGE_SIM_THREADS``, else ``default``; 0 = all cores."""
-    value = requested
-    if value is None:
-        env = os.environ.get(THREADS_ENV, "").strip()
-        value = int(env) if env else default
-    if value < 0:
-        raise ValueError(f"threads must be >= 0, not {value}")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return cores if value == 0 else value
-
-
-@cache
-def numba_available() -> bool:
-    """Import numba once (with the cache folder set up first); warn in one line if it is missing."""
-    _configure_cache_dir()
-    try:
-        import numba  # noqa: F401
-    except Exception as error:  # an incompatible or broken numba is as good as none
-        warnings.warn(f"numba unavailable ({error}); using the numpy kernels", RuntimeWarning, stacklevel=3)
-        return False
-    return True
+from stage_sim.backend import KERNELS, KERNELS_ENV, THREADS_ENV, resolve_threads
 
 
 def add_kernel_arguments(parser: argparse.ArgumentParser, threads_default: str = "1") -> None:
@@ -77,13 +16,6 @@ def add_kernel_arguments(parser: argparse.ArgumentParser, threads_default: str =
     parser.add_argument("--threads", type=int, default=None,
                         help=f"kernel threads, 0 = all cores, identical results (default: ${THREADS_ENV} or "
                              f"{threads_default})")
-
-
-def set_threads(threads: int) -> None:
-    """Let the next parallel kernel call use ``threads`` threads (capped at numba's pool size)."""
-    import numba
-
-    numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
 def let_idle_threads_sleep(realtime: bool, threads: int) -> None:
@@ -103,29 +35,3 @@ def threads_for_run(requested: int | None, speedup: float) -> int:
     threads = resolve_threads(requested, default=0 if speedup <= 0 else 1)
     let_idle_threads_sleep(speedup > 0, threads)
     return threads
-
-
-def announce_compilation(*dispatchers) -> None:
-    """Log "compiling simulation kernels, once" if some kernel is neither compiled nor cached on disk."""
-    for dispatcher in dispatchers:
-        if dispatcher.signatures:
-            continue
-        try:
-            index = Path(dispatcher._cache._cache_file._index_path)  # numba internals: the cache index
-        except AttributeError:
-            return
-        if not index.exists():
-            log.warning("compiling simulation kernels, once (cached in %s)", index.parent)
-            return
-
-
-def _configure_cache_dir() -> None:
-    """Point numba's cache at ``~/.cache/stage_sim`` when the package folder cannot hold it."""
-    if os.environ.get("NUMBA_CACHE_DIR") or os.access(_PACKAGE, os.W_OK):
-        return
-    user_cache = Path.home() / ".cache" / "stage_sim"
-    user_cache.mkdir(parents=True, exist_ok=True)
-    os.environ["NUMBA_CACHE_DIR"] = str(user_cache)
-    if "numba" in sys.modules:  # imported before us: tell its config too
-        sys.modules["numba"].config.CACHE_DIR = str(user_cache)
-

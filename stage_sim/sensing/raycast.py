@@ -52,6 +52,7 @@ from stage_sim.sensing.stage_walk import (
 
 # Rows of the integer state (_TILE: static tile of the region the walk is in, _RTILE: its robot tile).
 _ID, _KX, _KY, _E, _N, _SX, _SY, _BX, _BY, _Q, _IN, _CX, _CY, _R, _C, _CALC, _OWN, _XMAJ, _TILE, _RTILE = range(20)
+_NONE = np.zeros(0)  # no jitter, no trigonometry cache
 # Rows of the float state.
 (_BASEX, _BASEY, _STX, _STY, _COS, _SIN, _TAN, _XCX, _XCY, _YCX, _YCY, _DSX, _DSY, _XJX, _XJY, _YJX, _YJY, _XJD,
  _YJD) = range(19)
@@ -85,8 +86,6 @@ class GridRayCaster:
 
     ``occupied``: the layer in tiles, or a dense (H, W) grid; ``blocks`` (dense only): cells holding a
     block of any model at any height (they decide Stage's empty regions), default ``occupied``."""
-
-    kernels = "numpy"
 
     def __init__(self, occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float],
                  blocks: np.ndarray | None = None) -> None:
@@ -124,6 +123,23 @@ class GridRayCaster:
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             self._walk(rays, own, regions, active, walked, cell, hit_robot)
         return CastResult(ranges=finish_ranges(walked, rmax), hit_cell=cell, hit_robot=hit_robot)
+
+    def cast_into(
+        self, origins: np.ndarray, origin_of: np.ndarray, heading: np.ndarray, local: np.ndarray, rmax: np.ndarray,
+        owners: np.ndarray, robots: RobotLayer | None, out_at: np.ndarray, out: np.ndarray,
+        jitter: np.ndarray = _NONE, trig: tuple[np.ndarray, np.ndarray, np.ndarray] = (_NONE, _NONE, _NONE),
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`cast` as the simulation calls it (the arguments of
+        :meth:`~stage_sim.sensing.fast_caster.NumbaRayCaster.cast_into`): ray i from ``origins[origin_of[i]]``
+        at angle ``heading[origin_of[i]] + local[i]`` (plus ``jitter[out_at[i]]`` when given), its range written
+        to ``out[out_at[i]]``. ``trig`` (the compiled caster's cache of cosines and sines) is not needed here.
+        Returns (hit cell, hit robot) per ray."""
+        angles = heading[origin_of] + local
+        if jitter.size:
+            angles = angles + jitter[out_at]
+        result = self.cast(origins[origin_of], angles, rmax, owners=owners, robots=robots)
+        out[out_at] = result.ranges
+        return result.hit_cell, result.hit_robot
 
     # ------------------------------------------------------------------ the walk, all rays at once
     def _walk(self, rays: WalkRays, own, regions, robots, walked, cell, hit_robot) -> None:

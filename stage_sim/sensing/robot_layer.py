@@ -64,13 +64,12 @@ class RobotLayer:
     Each robot covers a set of cells. A ray hits a cell covered by a robot other than its owner; a cell
     covered by two or more robots blocks every ray (they touch there) and is reported as robot
     :data:`SEVERAL_ROBOTS`. Robots not visible at this layer's height (``visible[id]`` false) are left out
-    of the cells, not of :attr:`regions` (Stage's regions count every block).
+    of the cells, not of :attr:`regions` (Stage's regions count every block). What the numpy caster reads
+    (:class:`CompiledRobotLayer`: what the compiled one reads).
     """
 
-    def __init__(self, grid: TileGrid, compiled: bool = False) -> None:
-        """``compiled``: update with the numba kernels (:mod:`stage_sim.sensing.robot_kernels`), same result."""
+    def __init__(self, grid: TileGrid) -> None:
         self.grid = grid
-        self.compiled = compiled
         self._place = grid.place
         self.shape = grid.shape
         #: (R, C) int32 per region: its robot tile, :data:`MARKED`, or -1 (no robot cell there)
@@ -78,11 +77,6 @@ class RobotLayer:
         self.ids = np.full((0, TILE, TILE), -1, dtype=np.int32)  #: (T, 32, 32) robot id per cell
         self.blocks = np.full((0, TILE_BLOCKS, TILE_BLOCKS), -1, dtype=np.int32)  #: robot per 8 × 8 block
         self.block_squares = np.zeros((0, 4, TILE_BLOCKS, TILE_BLOCKS), dtype=np.uint8)
-        self.rows = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each row (compiled)
-        self.cols = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each column (compiled)
-        self.rows_used = np.zeros(0, dtype=np.uint32)  #: (T,) rows of a tile holding a robot cell (compiled)
-        self.cols_used = np.zeros(0, dtype=np.uint32)  #: (T,) columns of a tile holding one (compiled)
-        self.owner = np.zeros(0, dtype=np.int32)  #: (T,) the tile's one robot, or SEVERAL_ROBOTS (compiled)
         self._marked = np.empty(0, dtype=np.int64)
         self.active = False
 
@@ -99,9 +93,6 @@ class RobotLayer:
         visible: np.ndarray | None = None,
     ) -> None:
         """Replace the footprints: robot ``robot_ids[i]`` covers cell (``cell_rows[i]``, ``cell_cols[i]``)."""
-        if self.compiled:
-            self.update_flat(self._flat(cell_rows, cell_cols), robot_ids, visible)
-            return
         self.mark_regions(cell_rows, cell_cols)
         rows, cols, ids = visible_cells(cell_rows, cell_cols, robot_ids, self.shape, visible)
         rr, rc, ty, tx = self.grid.locate(rows * self.shape[1] + cols)
@@ -127,20 +118,7 @@ class RobotLayer:
 
     def update_flat(self, cells: np.ndarray, robot_ids: np.ndarray, visible: np.ndarray | None = None) -> None:
         """:meth:`update` with flat grid cells (−1: off the grid), as the simulation places bodies."""
-        if not self.compiled:
-            self.update(*self._rows_cols(cells), robot_ids, visible)
-            return
-        from stage_sim.sensing import robot_kernels
-
-        ids = np.asarray(robot_ids, dtype=np.int64).ravel()
-        seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
-        self._marked, tile, local, count = robot_kernels.number_robot_regions(
-            self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
-            self.shape[1], MARKED)
-        self._reserve(count)
-        self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
-                                                      self.owner, tile, local, ids.astype(np.int32), count,
-                                                      SEVERAL_ROBOTS)
+        self.update(*self._rows_cols(cells), robot_ids, visible)
 
     def _flat(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> np.ndarray:
         """Flat grid cells of (row, col) pairs, −1 for those off the grid."""
@@ -162,20 +140,14 @@ class RobotLayer:
         if count > self.ids.shape[0]:
             capacity = max(count, 2 * self.ids.shape[0])
             self.ids = np.empty((capacity, TILE, TILE), dtype=np.int32)
-            if self.compiled:
-                self.rows = np.empty((capacity, TILE), dtype=np.uint32)
-                self.cols = np.empty((capacity, TILE), dtype=np.uint32)
-                self.rows_used = np.empty(capacity, dtype=np.uint32)
-                self.cols_used = np.empty(capacity, dtype=np.uint32)
-                self.owner = np.empty(capacity, dtype=np.int32)
-            else:
-                self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
+            self._grow(capacity)
+
+    def _grow(self, capacity: int) -> None:
+        """Room for ``capacity`` tiles in what the caster reads besides the ids."""
+        self.blocks = np.empty((capacity, TILE_BLOCKS, TILE_BLOCKS), dtype=np.int32)
 
     def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
         """Make the regions of these robot cells non-empty (and only those besides the static ones)."""
-        if self.compiled:
-            self.mark_flat(self._flat(cell_rows, cell_cols))
-            return
         flat_regions = self.regions.ravel()
         flat_regions[self._marked] = -1
         rows, cols, _ = visible_cells(cell_rows, cell_cols, np.zeros(np.size(cell_rows), dtype=np.int64), self.shape,
@@ -186,15 +158,7 @@ class RobotLayer:
 
     def mark_flat(self, cells: np.ndarray) -> None:
         """:meth:`mark_regions` with flat grid cells (−1: off the grid)."""
-        if not self.compiled:
-            self.mark_regions(*self._rows_cols(cells))
-            return
-        from stage_sim.sensing import robot_kernels  # the compiled numbering, with no robot seen: marks only
-
-        cells = np.asarray(cells, dtype=np.int64).ravel()
-        self._marked = robot_kernels.number_robot_regions(
-            self.regions, self._marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=bool),
-            self._place, self.shape[1], MARKED)[0]
+        self.mark_regions(*self._rows_cols(cells))
 
     def look(self, tile, cy, cx, sx, sy, q, owner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """For walks standing in cell (cy, cx) of robot tile ``tile`` (≥ 0): (robot hit or -1, free cells ahead
@@ -212,3 +176,51 @@ class RobotLayer:
         kby = np.where(sy >= 0, ((bby + side) << BLOCK) - cy, cy + 1 - ((bby - side + 1) << BLOCK))
         return rid, kbx, kby, plain
 
+
+class CompiledRobotLayer(RobotLayer):
+    """:class:`RobotLayer` as the compiled caster reads it (row and column masks, used lines, owner per tile),
+    updated with the numba kernels (:mod:`stage_sim.sensing.robot_kernels`, imported on first use); the same
+    cells, ids and regions as the reference's."""
+
+    def __init__(self, grid: TileGrid) -> None:
+        super().__init__(grid)
+        self.rows = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each row
+        self.cols = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each column
+        self.rows_used = np.zeros(0, dtype=np.uint32)  #: (T,) rows of a tile holding a robot cell
+        self.cols_used = np.zeros(0, dtype=np.uint32)  #: (T,) columns of a tile holding one
+        self.owner = np.zeros(0, dtype=np.int32)  #: (T,) the tile's one robot, or SEVERAL_ROBOTS
+
+    def update(self, cell_rows: np.ndarray, cell_cols: np.ndarray, robot_ids: np.ndarray,
+               visible: np.ndarray | None = None) -> None:
+        self.update_flat(self._flat(cell_rows, cell_cols), robot_ids, visible)
+
+    def update_flat(self, cells: np.ndarray, robot_ids: np.ndarray, visible: np.ndarray | None = None) -> None:
+        from stage_sim.sensing import robot_kernels
+
+        ids = np.asarray(robot_ids, dtype=np.int64).ravel()
+        seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
+        self._marked, tile, local, count = robot_kernels.number_robot_regions(
+            self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
+            self.shape[1], MARKED)
+        self._reserve(count)
+        self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
+                                                      self.owner, tile, local, ids.astype(np.int32), count,
+                                                      SEVERAL_ROBOTS)
+
+    def _grow(self, capacity: int) -> None:
+        self.rows = np.empty((capacity, TILE), dtype=np.uint32)
+        self.cols = np.empty((capacity, TILE), dtype=np.uint32)
+        self.rows_used = np.empty(capacity, dtype=np.uint32)
+        self.cols_used = np.empty(capacity, dtype=np.uint32)
+        self.owner = np.empty(capacity, dtype=np.int32)
+
+    def mark_regions(self, cell_rows: np.ndarray, cell_cols: np.ndarray) -> None:
+        self.mark_flat(self._flat(cell_rows, cell_cols))
+
+    def mark_flat(self, cells: np.ndarray) -> None:
+        from stage_sim.sensing import robot_kernels  # the compiled numbering, with no robot seen: marks only
+
+        cells = np.asarray(cells, dtype=np.int64).ravel()
+        self._marked = robot_kernels.number_robot_regions(
+            self.regions, self._marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=bool),
+            self._place, self.shape[1], MARKED)[0]

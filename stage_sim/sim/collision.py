@@ -19,12 +19,12 @@ intermediate poses so that no speed the bounds allow can carry a body through a 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from stage_sim.maps.polygon_raster import point_cells
 from stage_sim.maps.tiles import TileLayer, unique_sorted
-from stage_sim.sensing.kernels import set_threads
 from stage_sim.sim.kinematics import integrate
 
 # Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
@@ -33,10 +33,6 @@ MAX_CONFLICT_ROUNDS = 4
 # Robots refused in a round times colliding robots up to which the next round's clash test is narrowed to
 # the robots near the refused ones by a distance test (beyond, the test takes every colliding robot).
 NARROWING_PAIRS = 200_000
-# Items (points, probes, robot pairs) from which a compiled loop is shared among threads.
-PARALLEL_ITEMS = 4096
-
-
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """World coordinates of body points (P, 2), each given with the pose (P, 3) of its robot."""
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
@@ -66,10 +62,6 @@ class Bodies:
         radius = np.array([np.hypot(*o.T).max() if len(o) else 0.0 for o in outlines])
         return cls(points, owner.astype(np.int64), len(outlines), width, radius)
 
-    def point_cells(self, poses: np.ndarray, grid: GridFrame) -> np.ndarray:
-        """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
-        return grid.body_cells(self.points, self.owner, poses)
-
 
 @dataclass(frozen=True)
 class GridFrame:
@@ -78,32 +70,33 @@ class GridFrame:
     shape: tuple[int, int]
     resolution: float
     origin_xy: tuple[float, float]
-    kernels: str = "numpy"
-    threads: int = 1  #: numba threads for the compiled loops over many items (the same answers for any)
+    threads: int = 1  #: threads of the compiled loops over many items (the same answers for any)
 
-    def compiled(self, module, name: str, items: int):
-        """The compiled kernel ``name`` of ``module``, its ``_parallel`` twin (on :attr:`threads` threads)
-        when there is more than one thread and more than :data:`PARALLEL_ITEMS` items to share."""
-        if self.threads > 1 and items > PARALLEL_ITEMS:
-            set_threads(self.threads)
-            return getattr(module, name + "_parallel")
-        return getattr(module, name)
 
-    def body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
-        if self.kernels == "numpy":
-            return point_cells(place(points, poses[pose_index]), self.resolution, self.origin_xy, self.shape)
-        from stage_sim.sim import collision_kernels
+class Contact(Protocol):
+    """The contact role of a kernel backend (:mod:`stage_sim.sim.backends`): where the bodies lie, which moves
+    are refused. :class:`CollisionChecker` is the numpy reference, and
+    :class:`~stage_sim.sim.compiled.CompiledCollisionChecker` gives its answers bit for bit."""
 
-        out = np.empty(len(points), dtype=np.int64)
-        self.compiled(collision_kernels, "body_cells", len(points))(
-            points, pose_index, poses[:, 0].copy(), poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]),
-            self.resolution, *self.origin_xy, *self.shape, out)
-        return out
+    def resolve(self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None,
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Move every robot by one step: (new poses, refused, every body point's cell at the new poses)."""
+        ...
+
+    def overlapping(self, poses: np.ndarray) -> np.ndarray:
+        """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
+        ...
+
+    def point_cells(self, poses: np.ndarray) -> np.ndarray:
+        """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
+        ...
 
 
 class CollisionChecker:
-    """Decides which robot moves to accept, given the static cells that block each robot's height band."""
+    """Decides which robot moves to accept, given the static cells that block each robot's height band: the
+    numpy reference of the :class:`Contact` role. The compiled backend overrides its hooks, with the same
+    answers: ``_body_cells``, ``_moves``, ``_contains``, ``_replace_cells``, ``_close_to_another``, ``_close_to``
+    and ``_clashes``."""
 
     def __init__(
         self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
@@ -115,37 +108,25 @@ class CollisionChecker:
         self._layer_of_robot = layer_of_robot
         self._collides = collides
         self._robots_can_clash = int(np.count_nonzero(collides)) > 1
-        self._in_layer = [layer_of_robot == i for i in range(len(layers))]  # per layer: its robots (N,)
         counts = np.bincount(bodies.owner, minlength=bodies.count)
         self._point_count = counts
         self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self._colliding = np.flatnonzero(collides)
-        # The compiled clash test's hash table: 24 B per slot, over twice the colliding robots' points.
-        points = int(counts[collides].sum()) if len(collides) else 0
-        size = 1 << max(1, (2 * points - 1).bit_length())
-        self._table = (np.full(size, -1, dtype=np.int64), np.empty(size, dtype=np.int64),
-                       np.empty(max(points, 1), dtype=np.int64))
 
     def resolve(
         self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Move every robot by one step; returns (new poses, refused, the cells of every body point at the new
-        poses, as :meth:`Bodies.point_cells`) with refused moves undone.
+        poses, as :meth:`point_cells`) with refused moves undone.
 
         Robots with zero velocity (``moving`` False, computed when not given) do not move and are never
         refused here; the caller keeps their previous stall flag, as Stage does."""
         moving = np.any(velocities != 0.0, axis=1) if moving is None else moving
         refused = np.zeros(len(poses), dtype=bool)
         movers = np.flatnonzero(moving & self._collides)
-        if self.grid.kernels == "numba":
-            candidates = self._compiled_moves(poses, velocities, dt, moving, movers, refused)
-        else:
-            candidates = poses.copy()
-            candidates[moving] = integrate(poses[moving], velocities[moving], dt)
-            if movers.size:
-                refused[movers] = self._hits_static(poses, velocities, dt, movers)
+        candidates = self._moves(poses, velocities, dt, moving, movers, refused)
         final = np.where(refused[:, None], poses, candidates)
-        cells = self.bodies.point_cells(final, self.grid)
+        cells = self.point_cells(final)
         if not self._robots_can_clash:
             return final, refused, cells
         among = self._crowded(final)
@@ -172,7 +153,27 @@ class CollisionChecker:
             touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
         if not self._robots_can_clash:
             return touching
-        return touching | self._clashes(self.bodies.point_cells(poses, self.grid), self._colliding)
+        return touching | self._clashes(self.point_cells(poses), self._colliding)
+
+    def point_cells(self, poses: np.ndarray) -> np.ndarray:
+        """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
+        return self._body_cells(self.bodies.points, self.bodies.owner, poses)
+
+    def _body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
+        g = self.grid
+        return point_cells(place(points, poses[pose_index]), g.resolution, g.origin_xy, g.shape)
+
+    def _moves(
+        self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray, movers: np.ndarray,
+        refused: np.ndarray,
+    ) -> np.ndarray:
+        """The candidate poses of one step; marks in ``refused`` the movers whose sweep meets a static cell."""
+        candidates = poses.copy()
+        candidates[moving] = integrate(poses[moving], velocities[moving], dt)
+        if movers.size:
+            refused[movers] = self._hits_static(poses, velocities, dt, movers)
+        return candidates
 
     def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
@@ -192,7 +193,7 @@ class CollisionChecker:
             substeps, substeps)
         probes = integrate(poses[robot], velocities[robot] * fraction[:, None], dt)
         point_index, probe = self._points_of(robot)
-        cells = self.grid.body_cells(self.bodies.points[point_index], probe, probes)
+        cells = self._body_cells(self.bodies.points[point_index], probe, probes)
         point_robot = robot[probe]
         layer_index = self._layer_of_robot[point_robot]
         hit = np.zeros(len(cells), dtype=bool)
@@ -202,59 +203,15 @@ class CollisionChecker:
         return (np.bincount(point_robot[hit], minlength=self.bodies.count) > 0)[movers]
 
     def _contains(self, layer: TileLayer, cells: np.ndarray) -> np.ndarray:
-        """Whether each flat cell is in the static layer (the compiled lookup when the kernels are numba's)."""
-        if self.grid.kernels == "numpy":
-            return layer.contains(cells)
-        from stage_sim.sim.collision_kernels import layer_contains
-
-        out = np.empty(cells.size, dtype=bool)
-        grid = layer.grid
-        layer_contains(cells, grid.slots, layer.tile_of_slot, layer.bits, grid.place, grid.shape[1], out)
-        return out
-
-    def _compiled_moves(
-        self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray, movers: np.ndarray,
-        refused: np.ndarray,
-    ) -> np.ndarray:
-        """The numba path of the candidate poses and :meth:`_hits_static` (marking ``refused``), equal to it bit
-        for bit (:mod:`stage_sim.sim.sweep_kernels`): a handful of calls instead of some forty."""
-        from stage_sim.sim import motion_kernels, sweep_kernels
-
-        cos_a, sin_a = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-        candidates = np.empty_like(poses)
-        motion_kernels.integrate_poses(poses, velocities, dt, cos_a, sin_a, candidates)
-        candidates = np.where(moving[:, None], candidates, poses)
-        if not movers.size:
-            return candidates
-        x, y, heading, robot = sweep_kernels.probe_poses(
-            poses, velocities, dt, movers, np.hypot(velocities[:, 0], velocities[:, 1]), self.bodies.radius,
-            self.bodies.min_width, self.grid.resolution, cos_a, sin_a)
-        cos_p, sin_p = np.cos(heading), np.sin(heading)
-        hit = np.zeros(len(poses), dtype=bool)
-        for i, layer in enumerate(self._layers):
-            grid = layer.grid
-            self.grid.compiled(sweep_kernels, "static_hits", len(x))(
-                self.bodies.points, self._point_start, self._point_count, x, y, cos_p, sin_p, robot,
-                self._in_layer[i], self.bodies.radius, self.grid.resolution, *self.grid.origin_xy, *self.grid.shape,
-                grid.slots, grid.place, layer.tile_of_slot, layer.bits, hit)
-        refused[movers] = hit[movers]
-        return candidates
+        """Whether each flat cell is in the static layer."""
+        return layer.contains(cells)
 
     def _replace_cells(self, cells: np.ndarray, poses: np.ndarray, robots: np.ndarray) -> None:
-        """Put the cells of ``robots``' points (entries of :meth:`Bodies.point_cells`) at ``poses`` into ``cells``."""
+        """Put the cells of ``robots``' points (entries of :meth:`point_cells`) at ``poses`` into ``cells``."""
         if not robots.size:
             return
-        if self.grid.kernels == "numba":
-            from stage_sim.sim import collision_kernels
-
-            g = self.grid
-            kernel = g.compiled(collision_kernels, "robots_cells", int(self._point_count[robots].sum()))
-            kernel(self.bodies.points, self._point_start, self._point_count, robots, poses[:, 0].copy(),
-                   poses[:, 1].copy(), np.cos(poses[:, 2]), np.sin(poses[:, 2]), g.resolution, *g.origin_xy, *g.shape,
-                   cells)
-            return
         point_index, entry = self._points_of(robots)
-        cells[point_index] = self.grid.body_cells(self.bodies.points[point_index], robots[entry], poses)
+        cells[point_index] = self._body_cells(self.bodies.points[point_index], robots[entry], poses)
 
     def _crowded(self, poses: np.ndarray) -> np.ndarray:
         """The colliding robots within touching distance of another at ``poses`` (centres no farther apart than
@@ -263,29 +220,24 @@ class CollisionChecker:
         robots = self._colliding
         if robots.size * (robots.size - 1) // 2 > NARROWING_PAIRS:
             return robots
-        if self.grid.kernels == "numba":
-            from stage_sim.sim.collision_kernels import crowded
+        return robots[self._close_to_another(robots, poses)]
 
-            close = np.zeros(robots.size, dtype=bool)
-            crowded(robots, poses, self.bodies.radius, 2 * self.grid.resolution, close)
-            return robots[close]
+    def _close_to_another(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Per robot of ``robots``: whether another of them is within touching distance at ``poses``."""
         close = self._touching(robots, robots, poses)
         np.fill_diagonal(close, False)
-        return robots[close.any(axis=1)]
+        return close.any(axis=1)
 
     def _near(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """The colliding robots whose bodies at ``poses`` could share a cell with one of ``robots``' (centres no
         farther apart than their radii and two cells), ``robots`` included; all of them for many ``robots``."""
         if robots.size * self._colliding.size > NARROWING_PAIRS:
             return self._colliding
-        if self.grid.kernels == "numba":
-            from stage_sim.sim import collision_kernels
+        return self._colliding[self._close_to(robots, poses)]
 
-            near = np.zeros(self._colliding.size, dtype=bool)
-            kernel = self.grid.compiled(collision_kernels, "near_robots", robots.size * self._colliding.size)
-            kernel(self._colliding, robots, poses, self.bodies.radius, 2 * self.grid.resolution, near)
-            return self._colliding[near]
-        return self._colliding[self._touching(self._colliding, robots, poses).any(axis=1)]
+    def _close_to(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Per colliding robot: whether one of ``robots`` is within touching distance at ``poses``."""
+        return self._touching(self._colliding, robots, poses).any(axis=1)
 
     def _touching(self, others: np.ndarray, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
         """(others, robots) pairs whose centres at ``poses`` are no farther apart than their radii and two cells
@@ -298,11 +250,6 @@ class CollisionChecker:
         """Robots of ``among`` (colliding robots) whose body points (``cells``, per body point) share a cell
         with another robot of ``among``."""
         conflict = np.zeros(self.bodies.count, dtype=bool)
-        if self.grid.kernels == "numba":
-            from stage_sim.sim.collision_kernels import owner_clashes
-
-            owner_clashes(cells, among, self._point_start, self._point_count, *self._table, conflict)
-            return conflict
         taking = np.zeros(self.bodies.count, dtype=bool)
         taking[among] = True
         keep = (cells >= 0) & taking[self.bodies.owner]

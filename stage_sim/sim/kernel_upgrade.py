@@ -19,16 +19,15 @@ import os
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
-from importlib import import_module
-from types import ModuleType
 from typing import Any, Protocol
 
 import numpy as np
 
-from stage_sim.sensing.kernels import KERNELS_ENV, numba_available
+from stage_sim.backend import KERNELS_ENV, numba_available
+from stage_sim.sim.backends import Backend, backend_for
 
 log = logging.getLogger("stage_sim")
-_LOADED = {"numba": False}
+_LOADED = {"numba": False}  #: per kernels name: whether some simulation of this process runs on them
 
 
 def numba_loaded() -> bool:
@@ -36,9 +35,9 @@ def numba_loaded() -> bool:
     return _LOADED["numba"]
 
 
-def mark_numba_loaded() -> None:
-    """Record that the compiled kernels are loaded (later simulations use them from the start)."""
-    _LOADED["numba"] = True
+def note_kernels_running(kernels: str) -> None:
+    """Record that a simulation runs on ``kernels``: once on numba's, later simulations use them from the start."""
+    _LOADED[kernels] = True
 
 
 #: Beams per step above which the numpy reference would make the first seconds slow (it walks ~0.3 M rays/s):
@@ -63,11 +62,12 @@ class Upgradable(Protocol):
 
 @dataclass(frozen=True)
 class CompiledParts:
-    """What a simulation swaps in: the compiled collision checker, ray sensing and motion kernels."""
+    """What a simulation swaps in: the compiled collision checker and ray sensing, and the backend they are of
+    (its motion kernels, its name)."""
 
     collision: Any
     sensing: Any
-    motion: ModuleType
+    backend: Backend
 
 
 class KernelUpgrade:
@@ -112,12 +112,12 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     main thread never waits for numba's loading; None when numba is unavailable."""
     if not numba_available():
         return None
-    collision, sensing = sim.build_parts("numba")
-    motion = import_module("stage_sim.sim.motion_kernels")
-    motion.warm(len(sim.robots))
+    backend = backend_for("numba")
+    collision, sensing = sim.build_parts(backend.name)
+    backend.motion.warm(len(sim.robots))
     poses = sim.start_poses
     collision.overlapping(poses)
     collision.resolve(poses, np.full_like(poses, 1e-3), 0.1)  # loads the sweep kernels (nothing is kept)
     sensing.sense(poses, 0.0)
-    mark_numba_loaded()
-    return CompiledParts(collision, sensing, motion)
+    note_kernels_running(backend.name)
+    return CompiledParts(collision, sensing, backend)

@@ -12,22 +12,21 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from importlib import import_module
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
 from stage_sim.maps.tiles import CellValues
-from stage_sim.sensing.casters import make_caster
-from stage_sim.sensing.raycast import GridRayCaster
-from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS, RobotLayer
+from stage_sim.sensing.casters import RayCaster
+from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sim.collision import Bodies, GridFrame, place
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
-    from stage_sim.sensing.fast_caster import NumbaRayCaster
+    from stage_sim.sim.backends import Backend
 
 
 @dataclass
@@ -48,7 +47,7 @@ class _HeightGroup:
     ranger: np.ndarray
     angle: np.ndarray
     max_range: np.ndarray
-    caster: GridRayCaster | NumbaRayCaster
+    caster: RayCaster
     robots: RobotLayer
     intensity: CellValues
     robot_visible: np.ndarray
@@ -59,11 +58,15 @@ class RangerSensing:
     """Holds the beam tables of all rangers and produces their scans."""
 
     def __init__(
-        self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame, kernels: str = "numpy",
-        threads: int = 1,
+        self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame, backend: Backend,
+        point_cells: Callable[[np.ndarray], np.ndarray],
     ) -> None:
+        """``backend``: the kernels the rays are cast and their returns looked up with; ``point_cells``: the
+        cells of the robots' bodies at given poses (:meth:`~stage_sim.sim.collision.Contact.point_cells`)."""
         self._bodies = bodies
         self._grid = grid
+        self._backend = backend
+        self._point_cells = point_cells
         self._rangers = [(robot.index, ranger) for robot in robots for ranger in robot.rangers]
         owners, angles, ranges, heights, ranger_of_ray = [], [], [], [], []
         for k, (robot_index, ranger) in enumerate(self._rangers):
@@ -87,15 +90,13 @@ class RangerSensing:
         self._noisy = bool(np.any(self._noise != 0.0))
         self._angle_noisy = bool(np.any(self._noise[:, 2] != 0.0))
         ray_height = np.concatenate(heights) if heights else np.zeros(0)
-        self._groups = self._height_groups(robots, static, ray_height, kernels, threads)
+        self._groups = self._height_groups(robots, static, ray_height)
         self._slices = self._ranger_slices()
         self._scan_slots = [(robot_index, ranger.index, part)
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
-        # the compiled path looks up intensities in one pass (numba is imported only when it runs) and keeps
-        # every beam's last angle with its cos and sin (24 B a beam): a robot that did not turn (a stalled
-        # one) does not compute them again
-        self._returns = import_module("stage_sim.sim.ranger_kernels") if kernels == "numba" else None
-        self._trig = tuple(np.full(len(self._owner) if self._returns else 0, np.nan) for _ in range(3))
+        # every beam's last angle with its cos and sin (24 B a beam), which the compiled caster keeps: a robot
+        # that did not turn (a stalled one) does not compute them again
+        self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
@@ -120,7 +121,8 @@ class RangerSensing:
 
     def sense(self, poses: np.ndarray, time: float, body_cells: np.ndarray | None = None) -> None:
         """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``;
-        ``body_cells``: the robots' cells at ``poses`` when the caller has them (:meth:`Bodies.point_cells`)."""
+        ``body_cells``: the robots' cells at ``poses`` when the caller has them
+        (:meth:`~stage_sim.sim.collision.Contact.point_cells`)."""
         now_us = round(time * 1e6)
         due = ((now_us - self._last_us) >= self._interval_us) | self._stale
         self._stale = False
@@ -134,7 +136,7 @@ class RangerSensing:
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
         robot_cells = None
         if self._bodies.count:
-            robot_cells = self._bodies.point_cells(poses, self._grid) if body_cells is None else body_cells
+            robot_cells = self._point_cells(poses) if body_cells is None else body_cells
         jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
         origins = place(self._ranger_offset, poses[self._ranger_owner])
         for group in self._groups:
@@ -170,30 +172,12 @@ class RangerSensing:
             else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
                 group.robots.mark_flat(robot_cells)
             layer = group.robots
-        if self._returns is not None:
-            cell, hit_robot = group.caster.cast_into(
-                origins, ranger, poses[self._ranger_owner, 2], angle, max_range, owner, layer, rays, ranges,
-                jitter=self._no_jitter if jitter is None else jitter, trig=self._trig)
-            several = float(group.robot_return.max(initial=0.0))
-            static = group.intensity
-            kernel = self._grid.compiled(self._returns, "hit_intensity", cell.size)
-            kernel(cell, hit_robot, static.cells, static.values, group.robot_return, self._bodies.count > 1,
-                   SEVERAL_ROBOTS, several, rays, intensity)
-            return
-        angles = poses[owner, 2] + angle
-        if jitter is not None:
-            angles = angles + jitter[rays]
-        result = group.caster.cast(origins[ranger], angles, max_range, owners=owner, robots=layer)
-        ranges[rays] = result.ranges
-        static_hit = (result.hit_cell >= 0) & (result.hit_robot == -1)
-        hits = np.zeros(len(rays), dtype=np.float32)
-        hits[static_hit] = group.intensity.at(result.hit_cell[static_hit])
-        if self._bodies.count > 1:  # a lone robot never sees itself
-            robot_hit = result.hit_robot >= 0
-            hits[robot_hit] = group.robot_return[result.hit_robot[robot_hit]]
-            # A cell two robots share (they touch there) reports no single robot: the brighter one answers.
-            hits[result.hit_robot == SEVERAL_ROBOTS] = group.robot_return.max(initial=0.0)
-        intensity[rays] = hits
+        cell, hit_robot = group.caster.cast_into(
+            origins, ranger, poses[self._ranger_owner, 2], angle, max_range, owner, layer, rays, ranges,
+            jitter=self._no_jitter if jitter is None else jitter, trig=self._trig)
+        # a lone robot never sees itself
+        self._backend.hit_intensity(cell, hit_robot, group.intensity, group.robot_return, self._bodies.count > 1,
+                                    rays, intensity, self._grid.threads)
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
         """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle
@@ -221,17 +205,16 @@ class RangerSensing:
         out[rays] = np.where(hit, ranges[rays] + ranges[rays] * prop * u_range + gauss, ranges[rays])
         return out
 
-    def _height_groups(
-        self, robots: list[RobotSpec], static: StaticRaster, ray_height: np.ndarray, kernels: str, threads: int
-    ) -> list:
+    def _height_groups(self, robots: list[RobotSpec], static: StaticRaster, ray_height: np.ndarray) -> list:
         groups = []
         returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
-        casters: dict[int, GridRayCaster | NumbaRayCaster] = {}  # heights that see the same static cells share one
+        casters: dict[int, RayCaster] = {}  # heights that see the same static cells share one
         for height in np.unique(ray_height):
             occupied, intensity = static.sensing_tiles(float(height))
             visible = np.array([r.z_band[0] <= height <= r.z_band[1] for r in robots], dtype=bool) & (returns >= 0)
             if id(occupied) not in casters:
-                casters[id(occupied)] = make_caster(occupied, static.resolution, static.origin_xy, kernels, threads)
+                casters[id(occupied)] = self._backend.caster(occupied, static.resolution, static.origin_xy,
+                                                             threads=self._grid.threads)
             caster = casters[id(occupied)]
             rays = np.flatnonzero(ray_height == height)
             groups.append(_HeightGroup(
@@ -252,3 +235,4 @@ class RangerSensing:
         counts = np.bincount(self._ranger_of_ray, minlength=len(self._rangers))
         ends = np.cumsum(counts)
         return [slice(int(e - n), int(e)) for n, e in zip(counts, ends, strict=True)]
+

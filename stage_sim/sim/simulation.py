@@ -17,18 +17,17 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import import_module
 from pathlib import Path
 
 import numpy as np
 
+from stage_sim.backend import resolve_kernels, resolve_threads
 from stage_sim.maps.raster import StaticRaster, build_static_raster
-from stage_sim.sensing.kernels import resolve_kernels, resolve_threads
-from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
+from stage_sim.sim.backends import Backend, backend_for
+from stage_sim.sim.collision import Bodies, Contact, GridFrame
 from stage_sim.sim.drives import group_by_drive
-from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, mark_numba_loaded, upgrade_wanted
-from stage_sim.sim.kinematics import body_velocity
-from stage_sim.sim.odometry import draw_odom_errors, integrate_odometry, relative_pose
+from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kernels_running, upgrade_wanted
+from stage_sim.sim.odometry import draw_odom_errors, relative_pose
 from stage_sim.sim.rangers import RangerSensing, Scan
 from stage_sim.sim.robots import RobotSpec, build_robots
 from stage_sim.worldfile.description import WorldDescription, WorldWarning
@@ -56,7 +55,7 @@ class Simulation:
     ) -> None:
         """``kernels``: "numba" or "numpy" (identical results; default numba, ``$STAGE_SIM_KERNELS``);
         ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
-        ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.sensing.kernels`."""
+        ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.backend`."""
         self.description = description
         self.warnings: list[WorldWarning] = list(description.warnings)
         self.robots: list[RobotSpec] = build_robots(description, self.warnings)
@@ -71,10 +70,8 @@ class Simulation:
         self.static: StaticRaster = build_static_raster(description, starts)
         self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
         self._collision, self._sensing = self.build_parts(self.kernels)
-        # numba is imported only when the compiled kernels run (the numpy path must work without it)
-        self._motion = import_module("stage_sim.sim.motion_kernels") if self.kernels == "numba" else None
-        if self.kernels == "numba":
-            mark_numba_loaded()
+        self._motion = backend_for(self.kernels).motion
+        note_kernels_running(self.kernels)
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
         self._drives = group_by_drive([r.settings.drive for r in self.robots])
@@ -181,30 +178,18 @@ class Simulation:
         if parts is None:
             return
         parts.sensing.adopt(self._sensing)
-        self._collision, self._sensing, self._motion = parts.collision, parts.sensing, parts.motion
-        self.kernels = "numba"
+        self._collision, self._sensing, self._motion = parts.collision, parts.sensing, parts.backend.motion
+        self.kernels = parts.backend.name
         self._upgrade = None
 
     def _body_velocities(self) -> np.ndarray:
-        """The body velocities the commands give (:func:`body_velocity`; one compiled pass with numba)."""
-        if self._motion is None:
-            return body_velocity(self.commands, self._drives, self._wheelbases, self._bounds)
-        steer = self.commands[:, 2]
-        out = np.empty_like(self.commands)
-        self._motion.body_velocities(self.commands, self._drives, self._wheelbases, self._bounds, np.cos(steer),
-                                     np.sin(steer), out)
-        return out
+        """The body velocities the commands give (drive + ``velocity_bounds``)."""
+        return self._motion.body_velocities(self.commands, self._drives, self._wheelbases, self._bounds)
 
     def _odometry(self, moved: np.ndarray, dt: float) -> np.ndarray:
         """Odometry after the step: integrated with the odom errors, or the true pose (gps localization)."""
-        if self._motion is None:
-            odom = integrate_odometry(self.odometry_poses, self.velocities, self.odom_errors, dt)
-            return np.where(self._uses_odom[:, None], odom, moved)
-        heading = self.odometry_poses[:, 2]
-        out = np.empty_like(moved)
-        self._motion.integrate_estimates(self.odometry_poses, self.velocities, self.odom_errors, dt,
-                                         np.cos(heading), np.sin(heading), self._uses_odom, moved, out)
-        return out
+        return self._motion.odometry(self.odometry_poses, self.velocities, self.odom_errors, dt, self._uses_odom,
+                                     moved)
 
     # -- queries ---------------------------------------------------------------------------------------
 
@@ -243,18 +228,20 @@ class Simulation:
 
     # -- construction helpers --------------------------------------------------------------------------
 
-    def build_parts(self, kernels: str) -> tuple[CollisionChecker, RangerSensing]:
+    def build_parts(self, kernels: str) -> tuple[Contact, RangerSensing]:
         """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used)."""
-        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, kernels, self.threads)
-        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, kernels, self.threads)
-        return self._make_collision_checker(grid), sensing
+        backend = backend_for(kernels)
+        grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.threads)
+        collision = self._make_collision_checker(backend, grid)
+        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, backend, collision.point_cells)
+        return collision, sensing
 
-    def _make_collision_checker(self, grid: GridFrame) -> CollisionChecker:
+    def _make_collision_checker(self, backend: Backend, grid: GridFrame) -> Contact:
         bands = sorted({r.z_band for r in self.robots})
         layers = [self.static.collision_tiles(*band) for band in bands]
         layer_of_robot = np.array([bands.index(r.z_band) for r in self.robots], dtype=np.int64)
         collides = np.array([r.model.obstacle_return for r in self.robots], dtype=bool)
-        return CollisionChecker(self._bodies, grid, layers, layer_of_robot, collides)
+        return backend.contact(self._bodies, grid, layers, layer_of_robot, collides)
 
     @staticmethod
     def _odometry_origin(robot: RobotSpec) -> tuple[float, float, float]:

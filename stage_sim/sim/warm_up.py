@@ -7,8 +7,8 @@ import logging
 
 import numpy as np
 
-from stage_sim.sensing.casters import make_caster
-from stage_sim.sensing.kernels import numba_available
+from stage_sim.backend import numba_available
+from stage_sim.sim.backends import backend_for
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
 
@@ -34,7 +34,7 @@ def warm() -> None:
     sim.set_velocity(0, 0.5, 0.0, 0.5)
     sim.step()
     big_batch = np.zeros((4096, 2))  # large enough for the parallel loop
-    make_caster(np.zeros((8, 8), dtype=bool), 0.1, (-0.4, -0.4), "numba", threads=2).cast(big_batch, 0.0, 1.0)
+    backend_for("numba").caster(np.zeros((8, 8), dtype=bool), 0.1, (-0.4, -0.4), threads=2).cast(big_batch, 0.0, 1.0)
 
 
 if __name__ == "__main__":

@@ -7,27 +7,28 @@ library's, as ``np.hypot``'s is), so the wanderer decides exactly as before (``t
 test_decisions.py`` replays recorded runs); they only spare the large temporary arrays, and the arc check
 stops at an arc's first collision, after which nothing about the arc matters. Without numba the same
 functions run as plain Python (``tests/wander/test_kernel_fallback.py``). Compiled on first use and
-cached on disk (``cache=True``: next to this file, or numba's user cache when that is not writable);
+cached on disk (``cache=True``: where :mod:`stage_sim.backend` sends numba's cache);
 :func:`warm_up` loads them before a robot's first scan, so that no decision waits for the compiler.
 """
 
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
-try:
-    import numba
-except Exception as error:  # missing or broken: the same loops run as plain Python (same decisions, slower)
-    numba = None
-    warnings.warn(f"numba unavailable ({error}); the wanderer's checks run as plain Python, slowly",
-                  RuntimeWarning, stacklevel=2)
+from stage_sim.backend import numba_available
+
 
 def _compiled(function):
-    """``numba.njit(cache=True)`` of ``function``, or the function itself when numba is unavailable."""
-    return function if numba is None else numba.njit(cache=True)(function)
+    """``numba.njit(cache=True)`` of ``function``, or the function itself when numba is unavailable
+    (:func:`~stage_sim.backend.numba_available` warns once; the same loops then run as plain Python: same
+    decisions, slower)."""
+    if not numba_available():
+        return function
+    import numba
+
+    return numba.njit(cache=True)(function)
 
 
 ROUNDING = 1e-9  # m: far more than the rounding error of any distance the checks compare

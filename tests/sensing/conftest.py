@@ -6,8 +6,8 @@ from functools import partial
 
 import pytest
 
+from stage_sim.backend import KERNELS
 from stage_sim.sensing.casters import make_caster
-from stage_sim.sensing.kernels import KERNELS
 
 
 @pytest.fixture(params=KERNELS)

@@ -1,0 +1,125 @@
+"""The one place where a kernels name (``"numpy"`` or ``"numba"``, :data:`stage_sim.backend.KERNELS`) becomes
+code: :func:`backend_for` returns the :class:`Backend` of that name, one implementation per role.
+
+Roles, each with the numpy reference and its compiled twin (identical answers bit for bit, ``tests/sim``,
+``tests/sensing``):
+
+* ray casting: :class:`~stage_sim.sensing.casters.RayCaster` (built by
+  :func:`~stage_sim.sensing.casters.make_caster`, the sensing layer's builder by name);
+* contact: :class:`~stage_sim.sim.collision.Contact` (:class:`~stage_sim.sim.collision.CollisionChecker`,
+  :class:`~stage_sim.sim.compiled.CompiledCollisionChecker`);
+* motion: :class:`Motion` (:class:`ReferenceMotion`, :class:`~stage_sim.sim.compiled.CompiledMotion`);
+* laser returns: :class:`HitIntensity` (:func:`~stage_sim.sim.returns.hit_intensity`,
+  :func:`stage_sim.sim.compiled.hit_intensity`).
+
+The numba backend's module is imported on first request only: the numpy path runs without numba.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cache, partial
+from typing import Protocol
+
+import numpy as np
+
+from stage_sim.backend import KERNELS
+from stage_sim.maps.tiles import CellValues, TileLayer
+from stage_sim.sensing.casters import RayCaster, make_caster
+from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame
+from stage_sim.sim.drives import DriveGroup
+from stage_sim.sim.kinematics import body_velocity
+from stage_sim.sim.odometry import integrate_odometry
+from stage_sim.sim.returns import hit_intensity
+
+
+class CasterFactory(Protocol):
+    """Builds the ray caster of one static layer (the arguments of :func:`~stage_sim.sensing.casters.make_caster`)."""
+
+    def __call__(self, occupied: np.ndarray | TileLayer, resolution: float, origin_xy: tuple[float, float], *,
+                 threads: int = 1, blocks: np.ndarray | None = None) -> RayCaster: ...
+
+
+class ContactFactory(Protocol):
+    """Builds the contact checker of a world (the arguments of :class:`~stage_sim.sim.collision.CollisionChecker`)."""
+
+    def __call__(self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
+                 collides: np.ndarray) -> Contact: ...
+
+
+class Motion(Protocol):
+    """Commands to body velocities, and odometry after a step, for all robots at once."""
+
+    def body_velocities(self, commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray,
+                        bounds: np.ndarray) -> np.ndarray:
+        """:func:`~stage_sim.sim.kinematics.body_velocity`."""
+        ...
+
+    def odometry(self, estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float,
+                 uses_odom: np.ndarray, truth: np.ndarray) -> np.ndarray:
+        """Odometry after the step: integrated with the errors for robots that ``uses_odom``, else ``truth``."""
+        ...
+
+    def warm(self, robots: int) -> None:
+        """Load what the first step would load (compiled kernels), for ``robots`` robots."""
+        ...
+
+
+class HitIntensity(Protocol):
+    """Writes each ray's return intensity (:func:`~stage_sim.sim.returns.hit_intensity`)."""
+
+    def __call__(self, cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, robot_return: np.ndarray,
+                 robots_seen: bool, rays: np.ndarray, out: np.ndarray, threads: int) -> None: ...
+
+
+class ReferenceMotion:
+    """:class:`Motion` on the numpy reference (:mod:`stage_sim.sim.kinematics`, :mod:`stage_sim.sim.odometry`)."""
+
+    @staticmethod
+    def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
+                        ) -> np.ndarray:
+        return body_velocity(commands, drives, wheelbases, bounds)
+
+    @staticmethod
+    def odometry(estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float,
+                 uses_odom: np.ndarray, truth: np.ndarray) -> np.ndarray:
+        return np.where(uses_odom[:, None], integrate_odometry(estimates, velocities, errors, dt), truth)
+
+    @staticmethod
+    def warm(robots: int) -> None:
+        """Nothing to load."""
+
+
+@dataclass(frozen=True)
+class Backend:
+    """One implementation of every hot path, all giving the numpy reference's answers."""
+
+    name: str  #: its name in :data:`stage_sim.backend.KERNELS`
+    caster: CasterFactory
+    contact: ContactFactory
+    motion: Motion
+    hit_intensity: HitIntensity
+
+
+def _numpy() -> Backend:
+    return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity)
+
+
+def _numba() -> Backend:
+    from stage_sim.sim import compiled  # imports numba
+
+    return Backend("numba", partial(make_caster, kernels="numba"), compiled.CompiledCollisionChecker,
+                   compiled.CompiledMotion(), compiled.hit_intensity)
+
+
+#: Every backend by name, built on first request.
+_BACKENDS = {"numpy": _numpy, "numba": _numba}
+
+
+@cache
+def backend_for(kernels: str) -> Backend:
+    """The backend called ``kernels`` (already resolved: :func:`stage_sim.backend.resolve_kernels`)."""
+    if kernels not in _BACKENDS:
+        raise ValueError(f"kernels must be one of {', '.join(KERNELS)}, not {kernels!r}")
+    return _BACKENDS[kernels]()

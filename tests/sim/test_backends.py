@@ -1,0 +1,64 @@
+"""One chooser maps a kernels name to the code that runs, and both backends fill every role of the interface."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stage_sim.backend import KERNELS
+from stage_sim.sensing.casters import RayCaster
+from stage_sim.sensing.fast_caster import NumbaRayCaster
+from stage_sim.sensing.raycast import GridRayCaster
+from stage_sim.sim import compiled, returns
+from stage_sim.sim.backends import Backend, Motion, ReferenceMotion, backend_for
+from stage_sim.sim.collision import CollisionChecker, Contact
+from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.loader import load_world_text
+
+WORLD = """
+define laser ranger ( sensor( range [0 2] fov 180 samples 9 ) )
+define bot position ( size [0.4 0.3 0.2] laser( ) )
+model( size [4 4 0.5] pose [0 0 0 0] boundary 1 )
+bot( pose [0 0 0 0] )
+bot( pose [1 0 0 0] )
+"""
+
+
+def _public_methods(protocol: type) -> set[str]:
+    return {name for name, value in vars(protocol).items() if callable(value) and not name.startswith("_")}
+
+
+def test_the_chooser_maps_each_name_to_its_implementations():
+    numpy, numba = backend_for("numpy"), backend_for("numba")
+    assert (numpy.name, numba.name) == ("numpy", "numba")
+    assert (numpy.contact, numba.contact) == (CollisionChecker, compiled.CompiledCollisionChecker)
+    assert isinstance(numpy.motion, ReferenceMotion) and isinstance(numba.motion, compiled.CompiledMotion)
+    assert (numpy.hit_intensity, numba.hit_intensity) == (returns.hit_intensity, compiled.hit_intensity)
+    assert isinstance(numpy.caster(np.zeros((4, 4), dtype=bool), 0.1, (0.0, 0.0)), GridRayCaster)
+    assert isinstance(numba.caster(np.zeros((4, 4), dtype=bool), 0.1, (0.0, 0.0)), NumbaRayCaster)
+    assert backend_for("numba") is numba  # built once
+    with pytest.raises(ValueError, match="kernels must be one of numba, numpy"):
+        backend_for("fortran")
+
+
+@pytest.mark.parametrize("kernels", KERNELS)
+def test_every_backend_fills_every_role(kernels):
+    backend = backend_for(kernels)
+    assert isinstance(backend, Backend)
+    caster = backend.caster(np.zeros((4, 4), dtype=bool), 0.1, (0.0, 0.0))
+    assert isinstance(caster, RayCaster)
+    for role, implementation in ((Contact, backend.contact), (Motion, type(backend.motion))):
+        missing = {name for name in _public_methods(role) if not callable(getattr(implementation, name, None))}
+        assert not missing, f"{implementation.__name__} lacks {missing}"
+
+
+@pytest.mark.parametrize("kernels", KERNELS)
+def test_a_simulation_runs_on_the_parts_its_kernels_name(kernels):
+    sim = Simulation(load_world_text(WORLD, "two.world"), seed=0, kernels=kernels)
+    backend = backend_for(kernels)
+    assert type(sim._collision) is backend.contact
+    assert sim._motion is backend.motion
+    assert all(isinstance(group.caster, RayCaster) for group in sim._sensing._groups)
+    sim.set_velocity(0, 0.3, 0.0, 0.2)
+    sim.step()
+    assert sim.scans[0][0].ranges.shape == (9,)
