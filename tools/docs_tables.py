@@ -1,0 +1,76 @@
+"""MkDocs hook: the tables of measured figures, made at build time from the benchmark scripts' JSON lines.
+
+`make bench` writes each script's JSON lines to ``docs/data/bench/<script>.jsonl`` and the command that
+printed them to ``<script>.command`` (``machine.json``: the machine's cores and CPU, and whether the short runs
+of ``make bench QUICK=1`` made them). A page asks for a table with an HTML comment::
+
+    <!-- bench simulate beams=240 kernels=numba | robots threads realtime_factor peak_rss_mb:MB -->
+
+that is: the data file, then ``key=value`` filters (all must hold), then after ``|`` the columns, each a key
+of the JSON lines with an optional format (``pct``: a share shown in percent; any other word: a unit put
+after the number). The table is followed by the commands that produced it, so no figure is typed by hand.
+A missing file, key or an empty selection fails the build.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+from mkdocs.config.defaults import MkDocsConfig
+from mkdocs.exceptions import PluginError
+from mkdocs.structure.files import Files
+from mkdocs.structure.pages import Page
+
+DATA = Path(__file__).resolve().parents[1] / "docs" / "data" / "bench"
+MARKER = re.compile(r"<!-- bench (?P<spec>[^|>]+)\|(?P<columns>[^>]+)-->")
+
+
+def read_lines(name: str) -> list[dict[str, Any]]:
+    path = DATA / f"{name}.jsonl"
+    if not path.is_file():
+        raise PluginError(f"no benchmark data {path}: run `make bench`")
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+def cell(value: Any, fmt: str | None) -> str:
+    if value is None:
+        return "—"
+    if fmt == "pct":
+        return f"{100 * value:.2f} %"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, list):
+        return " × ".join(map(str, value)) if value else "none"
+    text = f"{value:,}" if isinstance(value, (int, float)) else str(value)
+    return f"{text} {fmt}" if fmt else text
+
+
+def provenance(name: str) -> str:
+    """Which commands, run by which `make bench`, on what machine, made the file's lines."""
+    machine = json.loads((DATA / "machine.json").read_text())
+    make = "make bench QUICK=1" if machine["quick"] else "make bench"
+    commands = "; ".join(f"`{line}`" for line in (DATA / f"{name}.command").read_text().splitlines() if line)
+    return (f"*Measured by `{make}` on a {machine['cores']}-core machine ({machine['cpu']})"
+            f"{', short runs' if machine['quick'] else ''}: {commands}.*")
+
+
+def table(spec: str, columns: str) -> str:
+    name, *filters = spec.split()
+    wanted = dict(item.split("=", 1) for item in filters)
+    rows = [row for row in read_lines(name) if all(str(row.get(k)) == v for k, v in wanted.items())]
+    if not rows:
+        raise PluginError(f"bench table {name} {filters}: no line matches")
+    keys = [column.partition(":")[::2] for column in columns.split()]
+    missing = {key for key, _ in keys for row in rows if key not in row}
+    if missing:
+        raise PluginError(f"bench table {name}: lines without {sorted(missing)}")
+    head = "| " + " | ".join(key for key, _ in keys) + " |\n|" + "---|" * len(keys) + "\n"
+    body = "".join("| " + " | ".join(cell(row[key], fmt or None) for key, fmt in keys) + " |\n" for row in rows)
+    return head + body + "\n" + provenance(name) + "\n"
+
+
+def on_page_markdown(markdown: str, page: Page, config: MkDocsConfig, files: Files) -> str:
+    return MARKER.sub(lambda match: table(match["spec"], match["columns"]), markdown)
