@@ -9,7 +9,8 @@ of ``make bench QUICK=1`` made them). A page asks for a table with an HTML comme
 that is: the data file, then ``key=value`` filters (all must hold), then after ``|`` the columns, each a key
 of the JSON lines with an optional format (``pct``: a share shown in percent; any other word: a unit put
 after the number). The table is followed by the commands that produced it, so no figure is typed by hand.
-A missing file, key or an empty selection fails the build.
+A missing file, a key no selected line has, or an empty selection fails the build; a key only some
+lines have reads "—" in the others.
 """
 
 from __future__ import annotations
@@ -64,11 +65,11 @@ def table(spec: str, columns: str) -> str:
     if not rows:
         raise PluginError(f"bench table {name} {filters}: no line matches")
     keys = [column.partition(":")[::2] for column in columns.split()]
-    missing = {key for key, _ in keys for row in rows if key not in row}
+    missing = {key for key, _ in keys if all(key not in row for row in rows)}
     if missing:
-        raise PluginError(f"bench table {name}: lines without {sorted(missing)}")
+        raise PluginError(f"bench table {name}: no line has {sorted(missing)}")
     head = "| " + " | ".join(key for key, _ in keys) + " |\n|" + "---|" * len(keys) + "\n"
-    body = "".join("| " + " | ".join(cell(row[key], fmt or None) for key, fmt in keys) + " |\n" for row in rows)
+    body = "".join("| " + " | ".join(cell(row.get(key), fmt or None) for key, fmt in keys) + " |\n" for row in rows)
     return head + body + "\n" + provenance(name) + "\n"
 
 
