@@ -7,9 +7,9 @@ of ``make bench QUICK=1`` made them). A page asks for a table with an HTML comme
     <!-- bench simulate beams=240 kernels=numba | robots threads realtime_factor peak_rss_mb:MB -->
 
 that is: the data file, then ``key=value`` filters (all must hold), then after ``|`` the columns, each a key
-of the JSON lines with an optional format (``pct``: a share shown in percent; any other word: a unit put
-after the number). The table is followed by the commands that produced it, so no figure is typed by hand.
-A missing file, a key no selected line has, or an empty selection fails the build; a key only some
+of the JSON lines with an optional format (``pct``: a share shown in percent; ``M``: in millions; any other
+word: a unit put after the number). The table is followed by the commands that produced it, so no figure
+is typed by hand. A missing file, a key no selected line has, or an empty selection fails the build; a key only some
 lines have reads "—" in the others.
 """
 
@@ -45,8 +45,15 @@ def cell(value: Any, fmt: str | None) -> str:
         return "yes" if value else "no"
     if isinstance(value, list):
         return " × ".join(map(str, value)) if value else "none"
-    text = f"{value:,}" if isinstance(value, (int, float)) else str(value)
+    if fmt == "M":
+        return f"{value / 1e6:.3g} M"
+    text = number(value) if isinstance(value, (int, float)) else str(value)
     return f"{text} {fmt}" if fmt else text
+
+
+def number(value: float) -> str:
+    """Four significant digits below 100, whole numbers with thousands separators from there on."""
+    return f"{value:,.0f}" if abs(value) >= 100 else f"{value:.4g}"
 
 
 def provenance(name: str) -> str:
