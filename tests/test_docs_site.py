@@ -88,6 +88,11 @@ def test_a_key_only_some_lines_have_reads_a_dash(bench_data: Path) -> None:
     assert "| b | — |" in out
 
 
+def test_a_bare_key_selects_the_lines_that_have_it(bench_data: Path) -> None:
+    out = tables.on_page_markdown("<!-- bench demo share | case -->", None, None, None)
+    assert "| a |" in out and "| b |" not in out
+
+
 @pytest.mark.parametrize("marker", [
     "<!-- bench missing | robots -->",        # no data file
     "<!-- bench demo | speed -->",            # no line has the key

@@ -6,11 +6,11 @@ of ``make bench QUICK=1`` made them). A page asks for a table with an HTML comme
 
     <!-- bench simulate beams=240 kernels=numba | robots threads realtime_factor peak_rss_mb:MB -->
 
-that is: the data file, then ``key=value`` filters (all must hold), then after ``|`` the columns, each a key
-of the JSON lines with an optional format (``pct``: a share shown in percent; ``M``: in millions; any other
-word: a unit put after the number). The table is followed by the commands that produced it, so no figure
-is typed by hand. A missing file, a key no selected line has, or an empty selection fails the build; a key only some
-lines have reads "—" in the others.
+that is: the data file, then filters that must all hold (``key=value``, or a bare ``key`` the line must
+have), then after ``|`` the columns, each a key of the JSON lines with an optional format (``pct``: a share
+shown in percent; ``M``: in millions; any other word: a unit put after the number). The table is followed by
+the commands that produced it, so no figure is typed by hand. A missing file, a key no selected line has, or
+an empty selection fails the build; a key only some lines have reads "—" in the others.
 """
 
 from __future__ import annotations
@@ -67,8 +67,10 @@ def provenance(name: str) -> str:
 
 def table(spec: str, columns: str) -> str:
     name, *filters = spec.split()
-    wanted = dict(item.split("=", 1) for item in filters)
-    rows = [row for row in read_lines(name) if all(str(row.get(k)) == v for k, v in wanted.items())]
+    wanted = dict(item.split("=", 1) for item in filters if "=" in item)
+    present = [item for item in filters if "=" not in item]
+    rows = [row for row in read_lines(name)
+            if all(str(row.get(k)) == v for k, v in wanted.items()) and all(k in row for k in present)]
     if not rows:
         raise PluginError(f"bench table {name} {filters}: no line matches")
     keys = [column.partition(":")[::2] for column in columns.split()]
