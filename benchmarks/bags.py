@@ -87,7 +87,7 @@ def main() -> None:
             "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}), flush=True)
         for robots in args.robots:
             world = tmp / f"robots_{robots}.world"
-            world.write_text(world_text(robots, 240, seed=1))
+            world.write_text(world_text(robots, 240, 240.0, 5.6, seed=1))
             duration = args.throughput_duration or (600.0 if robots == 1 else 30.0)
             result = run(world, duration, "straight", tmp / f"robots_{robots}.mcap")
             print(json.dumps({
