@@ -84,7 +84,7 @@ bench: setup
 	$(call bench_run,envs,taskset -c 0 python benchmarks/envs.py $(call pick,,--seconds 3 --episodes 3))
 	$(call bench_run,fidelity,python benchmarks/fidelity.py)
 	$(call bench_run,wander_speed,taskset -c 0 python benchmarks/wander_speed.py $(call pick,,--steps 300))
-	$(call bench_run,wander_sweep,python benchmarks/wander_sweep.py --core --world rooms.world $(call pick,--seeds 20 --minutes 30,--seeds 2 --minutes 5 --jobs 1))
+	$(call bench_run,wander_sweep,python benchmarks/wander_sweep.py --core --world rooms.world $(call pick,--seeds 20 --minutes 30,--seeds 2 --minutes 30 --jobs 1))
 
 # The documentation site (mkdocs.yml, docs/) into site/, in strict mode: a broken link, reference or table fails.
 docs: setup

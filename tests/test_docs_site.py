@@ -76,9 +76,9 @@ def bench_data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def test_a_table_holds_the_selected_lines_and_says_which_command_made_them(bench_data: Path) -> None:
-    out = tables.on_page_markdown("<!-- bench demo case=a | robots rate share:pct -->", None, None, None)
-    assert "| robots | rate | share |" in out
-    assert "| 1 | 1,235 | 99.99 % |" in out
+    out = tables.on_page_markdown("<!-- bench demo case=a | robots rate share:pct rate:%+.1f -->", None, None, None)
+    assert "| robots | rate | share | rate |" in out
+    assert "| 1 | 1,235 | 99.99 % | +1234.6 |" in out
     assert "case" not in out.split("\n")[0] and "| 10 |" not in out
     assert "`make bench QUICK=1` on a 2-core machine (Test CPU), short runs: `python benchmarks/demo.py --fast`" in out
 

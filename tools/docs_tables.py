@@ -8,9 +8,10 @@ of ``make bench QUICK=1`` made them). A page asks for a table with an HTML comme
 
 that is: the data file, then filters that must all hold (``key=value``, or a bare ``key`` the line must
 have), then after ``|`` the columns, each a key of the JSON lines with an optional format (``pct``: a share
-shown in percent; ``M``: in millions; any other word: a unit put after the number). The table is followed by
-the commands that produced it, so no figure is typed by hand. A missing file, a key no selected line has, or
-an empty selection fails the build; a key only some lines have reads "—" in the others.
+shown in percent; ``M``: in millions; ``%SPEC``: Python's format SPEC, e.g. ``%+.4f``; any other word: a
+unit put after the number). The table is followed by the commands that produced it, so no figure is typed
+by hand. A missing file, a key no selected line has, or an empty selection fails the build; a key only some
+lines have reads "—" in the others.
 """
 
 from __future__ import annotations
@@ -47,6 +48,8 @@ def cell(value: Any, fmt: str | None) -> str:
         return " × ".join(map(str, value)) if value else "none"
     if fmt == "M":
         return f"{value / 1e6:.3g} M"
+    if fmt and fmt.startswith("%"):
+        return format(value, fmt[1:])
     text = number(value) if isinstance(value, (int, float)) else str(value)
     return f"{text} {fmt}" if fmt else text
 
