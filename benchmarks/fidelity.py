@@ -1,7 +1,7 @@
-"""How close stage_sim's scans are to the real Stage 4.3: the golden scans of ``tests/data/fidelity``.
+"""How close stage_sim's scans are to the real Stage 4.3: the golden scans in ``tests/data/fidelity``.
 
-Run with the venv's python: ``.venv/bin/python benchmarks/fidelity.py [--variants A B C]`` (the recordings:
-``tests/data/fidelity/rooms_<V>.jsonl``, read by :mod:`tests.maps.golden`). For every variant (A: rooms.world,
+Run with the venv's python: ``.venv/bin/python benchmarks/fidelity.py [--variants A B C]`` (the recordings
+are part of the repository). For every variant (A: rooms.world,
 B: resolution 0.05, C: floorplan turned by 30°) it prints one JSON object per line and source:
 
 * ``stage_sim``: stage_sim's first scan at each recorded pose;

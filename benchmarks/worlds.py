@@ -11,9 +11,8 @@ realtime_factor, ms_per_step, peak_rss_mb (the whole process, imports included).
 a step's time goes along a beam (inside the robot's own body, then over the empty regions beyond).
 
 * ``floorplan``: Stage's SFU demo shape: a 1200 m × 600 m floorplan from a 1200 × 615 bitmap at resolution
-  0.05 (24000 × 12000 cells), one robot with a 240-beam 240° 5.6 m laser. Stage's own bitmap when the
-  world corpus is beside the repository (``../shared/corpus``, or ``$STAGE_SIM_CORPUS``), else a generated
-  office-like one of the same size.
+  0.05 (24000 × 12000 cells), one robot with a 240-beam 240° 5.6 m laser. Stage's own bitmap (from the
+  world corpus in ``tests/data/corpus``).
 * ``rl``: the multi-robot RL worlds people build on stage_ros2: a 30 m × 30 m map at resolution 0.001
   (30000 × 30000 cells), 200 robots with 0.24 m bitmap bodies and 512-beam 180° 4 m lasers.
 """
@@ -38,8 +37,7 @@ import numpy as np  # noqa: E402
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-CORPUS = Path(os.environ.get("STAGE_SIM_CORPUS") or REPO.parent / "shared" / "corpus")
-SFU = CORPUS / "stage-worlds" / "bitmaps" / "SFU_1200x615.png"
+SFU = REPO / "tests" / "data" / "corpus" / "stage-worlds" / "bitmaps" / "SFU_1200x615.png"
 
 FLOORPLAN = """
 resolution 0.05
@@ -119,13 +117,9 @@ def world_text(name: str, folder: Path, rl_range: float = RL_RANGE) -> str:
     """The world file of case ``name``, its bitmaps written into ``folder`` (``rl_range``: the RL world's
     laser range)."""
     if name == "floorplan":
-        if SFU.exists():
-            from PIL import Image
+        from PIL import Image
 
-            bitmap, walls = SFU, np.asarray(Image.open(SFU).convert("L")) <= 127
-        else:
-            bitmap = folder / "office_1200x615.png"
-            walls = office_bitmap(bitmap, 1200, 615, 40, seed=1)
+        bitmap, walls = SFU, np.asarray(Image.open(SFU).convert("L")) <= 127
         # the trimmed bitmap is stretched to 1200 x 600 m centred on (0, -40)
         rows, cols = np.nonzero(walls)
         walls = walls[rows.min(): rows.max() + 1, cols.min(): cols.max() + 1]

@@ -6,7 +6,9 @@ as rosbag2 embeds it); one channel per topic (``cdr``) whose metadata holds ``of
 enums), written first so that a file cut short (kill -9) still says so after ``stage_sim recover``.
 
 Chunks are zstd-compressed and flushed to the operating system as soon as the library completes one, so
-after a kill -9 everything up to the last completed chunk is on disk.
+after a kill -9 everything up to the last completed chunk is on disk. A chunk closes at CHUNK_BYTES or once it
+spans CHUNK_SIM_SECONDS of sim time, whichever comes first, so a kill -9 of a run at real time loses about a
+second; closing by sim time, not wall time, keeps a recording's bytes the same from run to run.
 """
 
 from __future__ import annotations
@@ -22,7 +24,10 @@ from stage_sim.bags.errors import BAG_SUFFIX, BagError
 from stage_sim.bags.topics import Topic, yaml_text
 
 CHUNK_BYTES = 1024 * 1024
-"""Uncompressed bytes per chunk (the mcap and rosbag2 default): what a kill -9 can lose at most."""
+"""Uncompressed bytes per chunk at most (the mcap and rosbag2 default)."""
+CHUNK_SIM_SECONDS = 1.0
+"""Sim seconds one chunk spans at most: what a kill -9 loses of a slow recording (one robot at real time fills
+a 1 MiB chunk in about 28 s)."""
 PROFILE = "ros2"
 ROS_DISTRO = "jazzy"
 METADATA_VERSION = 9
@@ -84,6 +89,7 @@ class McapBag:
             self.abort()
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
         self._written = self._stream.tell()
+        self._chunk_start_ns: int | None = None
 
     def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
         """Add one message (log and publish time = its sim stamp); raises OSError when the disk refuses."""
@@ -91,6 +97,17 @@ class McapBag:
         if self._stream.tell() != self._written:  # the library has just completed a chunk: hand it to the OS
             self._stream.flush()
             self._written = self._stream.tell()
+            self._chunk_start_ns = None
+        elif self._chunk_start_ns is None:
+            self._chunk_start_ns = log_time_ns
+        elif log_time_ns - self._chunk_start_ns >= CHUNK_SIM_SECONDS * 1e9:
+            self.flush()
+
+    def flush(self) -> None:
+        """Close the open chunk and hand everything to the operating system (survives a kill -9 from now on)."""
+        self._writer.flush()
+        self._written = self._stream.tell()
+        self._chunk_start_ns = None
 
     def finish(self, metadata: dict[str, str] | None = None) -> None:
         """Write the last chunk, ``metadata`` (a ``stage_sim`` record), the summary and the footer; close."""

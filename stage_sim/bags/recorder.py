@@ -2,9 +2,15 @@
 
 After every step the stepping thread copies what the step published (:class:`StepState`) into a bounded
 queue and goes on; a writer thread builds, serialises and writes the messages. When the queue is full (the
-disk or the writer cannot keep up) the step is dropped, counted, and the count is said at exit and stored
-in the bag's ``stage_sim`` metadata record. A write error (full disk, file size limit) stops the recording
-with one message on stderr; the simulation goes on and the file stays readable up to its last chunk.
+writer, which shares the CPU with the simulation, or the disk cannot keep up):
+
+* a ``lossless`` recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
+  for the writer: the simulation slows down and every step is recorded;
+* a real-time recording drops the step rather than fall behind the wall clock: it is counted, the count is
+  said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
+
+A write error (full disk, file size limit) stops the recording with one message on stderr; the simulation
+goes on and the file stays readable up to its last chunk.
 """
 
 from __future__ import annotations
@@ -41,12 +47,18 @@ class BagSummary:
     dropped_messages: int
     error: str | None
 
+    @property
+    def complete(self) -> bool:
+        """Whether every step was recorded to the end: what the exit status of a recording run says."""
+        return not (self.error or self.dropped_steps)
+
     def describe(self) -> str:
         """One line for the user."""
         text = f"bag {self.path}: {self.messages} messages"
         if self.dropped_steps:
-            text += (f"; dropped {self.dropped_messages} messages of {self.dropped_steps} steps because the disk "
-                     "could not keep up (see the 'stage_sim' metadata record)")
+            text += (f"; dropped {self.dropped_messages} messages of {self.dropped_steps} steps: at real time the "
+                     "bag writer (which shares the CPU with the simulation) or the disk could not keep up; "
+                     "a run with --speedup 0 records every step (see the 'stage_sim' metadata record)")
         if self.error:
             text += f"; recording stopped early: {self.error} (recover the rest with: stage_sim recover {self.path})"
         return text
@@ -57,14 +69,16 @@ class BagRecorder:
 
     def __init__(
         self, sim: Simulation, path: str | Path, names: list[RobotNames], *, namespace: str = "/",
-        topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim",
+        topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim", lossless: bool = False,
     ) -> None:
         """Open the bag and write the latched messages (/tf_static, and /map when ``with_map``).
 
+        ``lossless``: :meth:`record_step` waits for room in the queue instead of dropping the step.
         ``topics`` restricts the recording to those names (relative ones resolved in ``namespace``).
         Raises ValueError for an unknown topic and BagError when the file cannot be written."""
         self._sim = sim
         self._prog = prog
+        self.lossless = lossless
         per_robot = robot_topics(names, namespace)
         self.topics = select(stageros_topics(per_robot, with_map), topics, namespace)
         self._wanted = {t.name for t in self.topics}
@@ -76,6 +90,8 @@ class BagRecorder:
         self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY)
         self.messages = self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
+        self.summary: BagSummary | None = None
+        """What was recorded, once :meth:`close` has run."""
         self._crash: BaseException | None = None
         try:
             grid = sim.static.to_occupancy_grid() if MAP in self._wanted else None
@@ -83,6 +99,7 @@ class BagRecorder:
                 if topic in self._wanted:
                     self._bag.write(topic, log_time, data)
                     self.messages += 1
+            self._bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             self._bag.abort()
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
@@ -100,17 +117,31 @@ class BagRecorder:
         return self.error is not None
 
     def record_step(self) -> None:
-        """Queue what the step just taken published; never blocks (a full queue drops the step)."""
+        """Queue what the step just taken published: a full queue makes a lossless recording wait for the
+        writer and a real-time one drop the step."""
         if self.failed:
             return
         state = StepState.capture(self._sim)
         try:
             self._queue.put_nowait(state)
-            if self._queue.qsize() >= self._batch:
-                self._wake.set()
         except queue.Full:
-            self.dropped_steps += 1
-            self.dropped_messages += self._per_step + sum((i, k) in self._scan_wanted for i, k, *_ in state.scans)
+            if not (self.lossless and self._wait_for_room(state)):
+                self.dropped_steps += 1
+                self.dropped_messages += self._per_step + sum((i, k) in self._scan_wanted for i, k, *_ in state.scans)
+                return
+        if self._queue.qsize() >= self._batch:
+            self._wake.set()
+
+    def _wait_for_room(self, state: StepState) -> bool:
+        """Queue ``state`` once the writer has made room; False if the writer stopped meanwhile (an error)."""
+        self._wake.set()
+        while self._thread.is_alive() and not self.failed and self._crash is None:
+            try:
+                self._queue.put(state, timeout=WAKE_S)
+                return True
+            except queue.Full:
+                self._wake.set()
+        return False
 
     def close(self) -> BagSummary:
         """Write what is queued, then the index: the file is complete. Safe to call once, also after errors."""
@@ -126,7 +157,8 @@ class BagRecorder:
                                   "dropped_messages": str(self.dropped_messages)})
             except OSError as exc:
                 self.error = exc.strerror or str(exc)
-        return BagSummary(self._bag.path, self.messages, self.dropped_steps, self.dropped_messages, self.error)
+        self.summary = BagSummary(self._bag.path, self.messages, self.dropped_steps, self.dropped_messages, self.error)
+        return self.summary
 
     def _drain(self) -> None:
         """The writer thread: build and write queued steps, a batch per wake-up, until the closing None."""

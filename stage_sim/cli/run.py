@@ -3,8 +3,8 @@
 The bag holds what ``stageros --bag`` records for the same world, seed and commands (same topics, frames,
 types, QoS and field values) but comes from the core alone: no rclpy, no ROS install. The run ends at
 ``--duration`` sim seconds, at the world's ``quit_time`` or on Ctrl-C / SIGTERM; each finalises the bag.
-Exit status 0 (also after Ctrl-C during the run), 1 when the bag could not be written to the end, 2 for bad
-input, 130 for Ctrl-C before the first step.
+Exit status 0 (also after Ctrl-C during the run), 1 when the bag misses steps (dropped at real time) or
+could not be written to the end, 2 for bad input, 130 for Ctrl-C before the first step.
 """
 
 from __future__ import annotations
@@ -55,8 +55,8 @@ def _run(args: argparse.Namespace) -> int:
         names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers), args.use_model_names)
                  for r in sim.robots]
         try:
-            recorder = BagRecorder(
-                sim, args.bag, names, topics=args.bag_topics, with_map=args.map, prog="stage_sim run")
+            recorder = BagRecorder(sim, args.bag, names, topics=args.bag_topics, with_map=args.map,
+                                   prog="stage_sim run", lossless=speedup <= 0)
         except (BagError, ValueError) as exc:
             print(f"stage_sim run: {exc}", file=sys.stderr)
             return 2
@@ -84,7 +84,7 @@ def _run(args: argparse.Namespace) -> int:
           f"{sim.threads} thread{'s' if sim.threads > 1 else ''})")
     if summary:
         print(summary.describe(), file=sys.stderr if summary.error or summary.dropped_steps else sys.stdout)
-    return 1 if summary and summary.error else 0
+    return 0 if summary is None or summary.complete else 1
 
 
 def add_command(subparsers: Any) -> None:

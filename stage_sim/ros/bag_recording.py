@@ -32,7 +32,9 @@ def add_bag_arguments(parser: argparse.ArgumentParser) -> None:
 @contextlib.contextmanager
 def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Iterator[BagRecorder | None]:
     """Record ``stage`` after every step while the block runs, then finalise the bag (also after Ctrl-C or
-    an error) and say what it holds on stderr; yields None when ``args.bag`` is unset. A bag that cannot be
+    an error) and say what it holds on stderr (``recorder.summary`` then, for the exit status); lossless (the
+    simulation waits for the writer) unless the node is paced to the wall clock. Yields None when ``args.bag``
+    is unset. A bag that cannot be
     created raises BagError (a bad path) or ValueError (an unknown topic) before anything runs."""
     if not args.bag:
         yield None
@@ -44,7 +46,8 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
                        "rosbags)") from error
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
-                           topics=args.bag_topics, with_map=stage.map_pub is not None, prog=prog)
+                           topics=args.bag_topics, with_map=stage.map_pub is not None, prog=prog,
+                           lossless=stage.speedup <= 0)
     stage.add_step_listener(recorder.record_step)
     try:
         yield recorder

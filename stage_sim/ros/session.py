@@ -48,7 +48,7 @@ class WanderSession:
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
             prefix = names.cmd_vel[: -len("cmd_vel")]
             remap = ["--ros-args", "-r", f"base_scan:={names.scans[0][len(prefix):]}"] if robot.rangers else None
-            overrides = [Parameter("holonomic", value=robot.settings.drive == "omni")]
+            overrides = [Parameter("holonomic", value=robot.drive.holonomic)]
             if seed is not None:
                 overrides.append(Parameter("seed", value=wanderer_seed(seed, index)))
             self.wanderers.append(Wander(
@@ -131,12 +131,12 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     try:
         with stop_requests() as stop:
             session = WanderSession(args.world, args.speedup, args.seed)
-            with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog),
+            with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog) as recorder,
                   viewing(session.stage, args)):
                 session.run(args.duration, stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)
-        return 0
+        return 0 if recorder is None or recorder.summary.complete else 1
     except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2

@@ -68,10 +68,11 @@ def main(argv: list[str] | None = None) -> int:
                 kernels=args.kernels, threads=args.threads)
             executor = SingleThreadedExecutor()
             executor.add_node(node)
-            with recording(node, args, "stageros"), viewing(node, args), bag_recording(node, args, "stageros"):
+            with (recording(node, args, "stageros"), viewing(node, args),
+                  bag_recording(node, args, "stageros") as recorder):
                 while rclpy.ok() and not node.finished and not stop.is_set():
                     executor.spin_once(timeout_sec=0.1)
-        return 0
+        return 0 if recorder is None or recorder.summary.complete else 1
     except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"stageros: {error}", file=sys.stderr)
         return 2

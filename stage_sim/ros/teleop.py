@@ -8,6 +8,7 @@ command. The key source is injectable (:class:`KeyReader` takes any stream or de
 
 from __future__ import annotations
 
+import argparse
 import codecs
 import io
 import os
@@ -30,6 +31,7 @@ from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import remove_ros_args
 
 from stage_sim.runs.interrupts import sigterm_interrupts
 
@@ -229,8 +231,25 @@ class TeleopTwistKeyboard(Node):
                 self.publish_velocity((0.0, 0.0, 0.0, 0.0))
 
 
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    """``--help`` (and a clear error for anything else that is not a ROS argument)."""
+    parser = argparse.ArgumentParser(
+        prog="teleop", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Drive a robot from the keyboard, as teleop_twist_keyboard does: each key press publishes "
+        "one Twist on cmd_vel (relative: --ros-args -r __ns:=/robot_0 picks a robot). Needs a terminal.\n" + HELP,
+        epilog="parameters (--ros-args -p NAME:=VALUE): speed (m/s), turn (rad/s), stamped (TwistStamped), "
+        "frame_id (with stamped)")
+    return parser.parse_args(argv)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the teleop on stdin until Ctrl-C; 0 on a normal quit, 2 on bad parameters."""
+    """Run the teleop on stdin until Ctrl-C; 0 on a normal quit, 2 on bad parameters or without a terminal."""
+    argv = list(sys.argv if argv is None else argv)
+    parse_args(remove_ros_args(argv)[1:])
+    if not sys.stdin.isatty():
+        print("teleop: needs a terminal to read single key presses from (standard input is not one); run it in "
+              "a terminal of its own", file=sys.stderr)
+        return 2
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node: TeleopTwistKeyboard | None = None
     executor = SingleThreadedExecutor()

@@ -14,9 +14,11 @@ rectangles, flattened ``[x_min, x_max, y_min, y_max, ...]``), ``laser_pose`` ``[
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import sys
+import time
 from collections import deque
 from typing import Any
 
@@ -31,6 +33,7 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 from tf2_msgs.msg import TFMessage
@@ -46,6 +49,7 @@ RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 NEWEST_SCAN = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 ODOM_KEPT = 50  # recent odometry messages kept for pairing with scans by stamp
+NO_SCAN_WARNING_S = 5.0  # wall seconds without a scan before the console script says what it is missing
 
 
 def _nanoseconds(stamp: Any) -> int:
@@ -78,6 +82,7 @@ class Wander(Node):
         self._odometry: deque[tuple[int, tuple[float, float, float]]] = deque(maxlen=ODOM_KEPT)
         self._pending: LaserScan | None = None  # a scan waiting for the odometry of its stamp
         self._stalled = False  # whether a stall was reported since the last decision
+        self.decisions = 0  # commands published so far
         self.publisher = self.create_publisher(Twist, "cmd_vel", RELIABLE_10)
         # Created first: when a step's stall and scan are both waiting, the executor takes the stall first.
         self.create_subscription(Bool, "stall", self.on_stall, RELIABLE_10)
@@ -119,6 +124,7 @@ class Wander(Node):
             scan.range_max, self.laser_poses.get(scan.header.frame_id, self.default_laser_pose))
         vx, vy, wz = self.wanderer.decide(reading, _nanoseconds(scan.header.stamp) / 1e9, pose, self._stalled)
         self._stalled = False
+        self.decisions += 1
         msg = Twist()
         msg.linear.x, msg.linear.y, msg.angular.z = vx, vy, wz
         self.publisher.publish(msg)
@@ -129,17 +135,39 @@ class Wander(Node):
             self.publisher.publish(Twist())
 
 
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    """``--help`` (and a clear error for anything else that is not a ROS argument)."""
+    parser = argparse.ArgumentParser(
+        prog="wander", description="A reactive wanderer: drives one robot from its laser scans without "
+        "stopping or colliding, and explores the map. Subscribes base_scan, odom, stall and /tf_static; "
+        "publishes cmd_vel (relative names: a namespace, e.g. --ros-args -r __ns:=/robot_0, picks the robot).",
+        epilog="parameters (--ros-args -p NAME:=VALUE): forward_speed (m/s), safety_distance (m), turn_rate "
+        "(rad/s), holonomic (omni drive), seed (-1: random), footprint [x_min, x_max, y_min, y_max, ...], "
+        "laser_pose [x, y, yaw] (until /tf_static gives it)")
+    return parser.parse_args(argv)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the wanderer until Ctrl-C, SIGTERM or shutdown, then stop the robot; returns the exit status."""
-    rclpy.init(args=sys.argv if argv is None else argv, signal_handler_options=SignalHandlerOptions.NO)
+    argv = list(sys.argv if argv is None else argv)
+    parse_args(remove_ros_args(argv)[1:])
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = None
     try:
         with stop_requests() as stop:
             node = Wander()
+            scans = node.resolve_topic_name("base_scan")
+            node.get_logger().info(f"waiting for scans on {scans}; commands go to {node.resolve_topic_name('cmd_vel')}")
             executor = SingleThreadedExecutor()
             executor.add_node(node)
+            started, warned = time.monotonic(), False
             while not stop.is_set():
                 executor.spin_once(timeout_sec=0.1)
+                if not warned and node.decisions == 0 and time.monotonic() - started > NO_SCAN_WARNING_S:
+                    warned = True
+                    node.get_logger().warning(
+                        f"no scan on {scans} after {NO_SCAN_WARNING_S:g} s: is stageros running, on the same "
+                        f"ROS_DOMAIN_ID ({os.environ.get('ROS_DOMAIN_ID', '0')}), with this robot's namespace?")
         return 0
     except ExternalShutdownException:
         return 0

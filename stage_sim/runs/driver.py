@@ -36,7 +36,7 @@ class WanderDriver:
         self.wanderers: dict[int, Wanderer] = {}
         for robot in sim.robots:
             if robot.rangers:
-                settings = replace(base, holonomic=robot.settings.drive == "omni")
+                settings = replace(base, holonomic=robot.drive.holonomic)
                 self.wanderers[robot.index] = Wanderer(settings, wanderer_seed(seed, robot.index))
 
     def reading(self, robot: int) -> LaserReading:

@@ -1,4 +1,4 @@
-"""Stage's velocity-control kinematics for many robots at once (``drive`` diff / omni / car).
+"""Stage's velocity-control kinematics for many robots at once, whatever their drives.
 
 Per step of length ``dt`` (Stage's ``Move``), with the heading ``a`` at the start of the step::
 
@@ -6,16 +6,18 @@ Per step of length ``dt`` (Stage's ``Move``), with the heading ``a`` at the star
     y' = y + vx·dt·sin a + vy·dt·cos a
     a' = normalize(a + normalize(va·dt))
 
-The body velocity comes from the command (gx, gy, ga): diff (gx, 0, ga), omni (gx, gy, ga), car
-(gx·cos ga, 0, gx·sin ga / wheelbase) where ga is the steering angle; each component is then clamped to the
-robot's ``velocity_bounds``. There is no acceleration limit in velocity mode (Stage's behaviour).
+The body velocity (vx, vy, va) comes from the command (gx, gy, ga) by the robot's drive model
+(:mod:`stage_sim.sim.drives`); each component is then clamped to the robot's ``velocity_bounds``. There is no
+acceleration limit in velocity mode (Stage's behaviour).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
-DRIVE_CODES = {"diff": 0, "omni": 1, "car": 2}
+from stage_sim.sim.drives import DriveGroup
 
 
 def normalize_angle(angle: np.ndarray | float) -> np.ndarray:
@@ -25,20 +27,17 @@ def normalize_angle(angle: np.ndarray | float) -> np.ndarray:
 
 
 def body_velocity(
-    commands: np.ndarray, drives: np.ndarray, wheelbases: np.ndarray, bounds: np.ndarray
+    commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray
 ) -> np.ndarray:
     """Body-frame velocities (vx, vy, va) that Stage applies for commands (gx, gy, ga).
 
-    ``commands`` is (N, 3), ``drives`` (N,) codes from :data:`DRIVE_CODES`, ``wheelbases`` (N,) and
-    ``bounds`` (N, 8) ``velocity_bounds`` (xmin xmax ymin ymax zmin zmax amin amax) in SI units.
+    ``commands`` is (N, 3), ``drives`` the robots of each drive (every robot in one group, see
+    :func:`~stage_sim.sim.drives.group_by_drive`), ``wheelbases`` (N,) and ``bounds`` (N, 8)
+    ``velocity_bounds`` (xmin xmax ymin ymax zmin zmax amin amax) in SI units.
     """
-    gx, gy, ga = commands[:, 0], commands[:, 1], commands[:, 2]
-    is_omni = drives == DRIVE_CODES["omni"]
-    is_car = drives == DRIVE_CODES["car"]
-    vx = np.where(is_car, gx * np.cos(ga), gx)
-    vy = np.where(is_omni, gy, 0.0)
-    va = np.where(is_car, gx * np.sin(ga) / wheelbases, ga)
-    velocity = np.stack([vx, vy, va], axis=1)
+    velocity = np.empty_like(commands)
+    for group in drives:
+        velocity[group.rows] = group.drive.velocities(commands[group.rows], wheelbases[group.rows])
     low = bounds[:, [0, 2, 6]]
     high = bounds[:, [1, 3, 7]]
     return np.clip(velocity, low, high)

@@ -4,17 +4,21 @@
 Why: for one or ten robots a step is dominated by the dozens of small numpy calls of the reference, not by
 arithmetic. The trigonometry stays in numpy (the caller passes the cosines and sines, computed by the same
 numpy calls as the reference, which on some CPUs differ in the last bit from libm), so every pose here is the
-reference's pose bit for bit (``tests/sim/test_motion_kernels.py``).
+reference's pose bit for bit (``tests/sim/test_motion_kernels.py``). Body velocities are computed one drive
+at a time by each drive's own twin (:mod:`stage_sim.sim.drives`), compiled here.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numba
 import numpy as np
 
+from stage_sim.sim.drives import DRIVES, DriveGroup
+
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
-_CAR = 2
-_OMNI = 1
+_VELOCITY_KERNELS = {name: numba.njit(**_JIT)(drive.compiled_velocities) for name, drive in DRIVES.items()}
 
 
 @numba.njit(inline="always", **_JIT)
@@ -24,21 +28,22 @@ def normalize(angle):
     return np.pi if wrapped == -np.pi else wrapped
 
 
+def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
+                    cos_steer: np.ndarray, sin_steer: np.ndarray, out: np.ndarray) -> None:
+    """:func:`~stage_sim.sim.kinematics.body_velocity` into ``out`` (N, 3): one compiled pass per drive, then
+    one clamping pass; ``cos_steer``/``sin_steer``: numpy's cos/sin of ``commands[:, 2]`` (car drives read them)."""
+    for group in drives:
+        _VELOCITY_KERNELS[group.drive.name](commands, group.rows, wheelbases, cos_steer, sin_steer, out)
+    clamp_velocities(out, bounds)
+
+
 @numba.njit(**_JIT)
-def body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out):
-    """:func:`~stage_sim.sim.kinematics.body_velocity` into ``out`` (N, 3); ``cos_steer``/``sin_steer``:
-    numpy's cos/sin of ``commands[:, 2]`` (read for car drives only)."""
-    for i in range(commands.shape[0]):
-        gx, gy, ga = commands[i, 0], commands[i, 1], commands[i, 2]
-        vx, vy, va = gx, 0.0, ga
-        if drives[i] == _CAR:
-            vx = gx * cos_steer[i]
-            va = gx * sin_steer[i] / wheelbases[i]
-        elif drives[i] == _OMNI:
-            vy = gy
-        out[i, 0] = min(max(vx, bounds[i, 0]), bounds[i, 1])
-        out[i, 1] = min(max(vy, bounds[i, 2]), bounds[i, 3])
-        out[i, 2] = min(max(va, bounds[i, 6]), bounds[i, 7])
+def clamp_velocities(velocities, bounds):
+    """Clamp (vx, vy, va) in place to ``velocity_bounds`` (N, 8), as ``np.clip`` does in the reference."""
+    for i in range(velocities.shape[0]):
+        velocities[i, 0] = min(max(velocities[i, 0], bounds[i, 0]), bounds[i, 1])
+        velocities[i, 1] = min(max(velocities[i, 1], bounds[i, 2]), bounds[i, 3])
+        velocities[i, 2] = min(max(velocities[i, 2], bounds[i, 6]), bounds[i, 7])
 
 
 @numba.njit(**_JIT)
@@ -70,7 +75,8 @@ def integrate_estimates(estimates, velocities, errors, dt, cos_a, sin_a, uses_od
 def warm(robots: int) -> None:
     """Run every kernel once on arrays of the simulation's types, loading them from numba's cache."""
     n = max(robots, 1)
-    values, flags, codes = np.zeros((n, 3)), np.zeros(n, dtype=np.bool_), np.zeros(n, dtype=np.int64)
-    column, out = np.zeros(n), np.empty((n, 3))
-    body_velocities(values, codes, column, np.zeros((n, 8)), column, column, out)
+    values, flags, rows = np.zeros((n, 3)), np.zeros(n, dtype=np.bool_), np.arange(n, dtype=np.int64)
+    column, out = np.ones(n), np.empty((n, 3))
+    every_drive = [DriveGroup(drive, rows) for drive in DRIVES.values()]
+    body_velocities(values, every_drive, column, np.zeros((n, 8)), column, column, out)
     integrate_estimates(values, values, np.zeros((n, 4)), 0.1, column, column, flags, values, out)

@@ -15,7 +15,7 @@ import numpy as np
 
 from stage_sim.maps.body_geometry import body_polygons, global_poses, transform_points
 from stage_sim.maps.polygon_raster import outline_points
-from stage_sim.sim.kinematics import DRIVE_CODES
+from stage_sim.sim.drives import DRIVES, Drive
 from stage_sim.worldfile.description import Model, Pose, PositionSettings, Sensor, WorldDescription, WorldWarning
 from stage_sim.worldfile.errors import SourceLocation
 
@@ -56,9 +56,9 @@ class RobotSpec:
     rangers: tuple[RangerSpec, ...]
 
     @property
-    def drive_code(self) -> int:
-        """Drive as an integer for the vectorised kinematics."""
-        return DRIVE_CODES[self.settings.drive]
+    def drive(self) -> Drive:
+        """The robot's drive model (its world-file ``drive``)."""
+        return DRIVES[self.settings.drive]
 
     @property
     def radius(self) -> float:

@@ -25,6 +25,7 @@ import numpy as np
 from stage_sim.maps.raster import StaticRaster, build_static_raster
 from stage_sim.sensing.kernels import resolve_kernels, resolve_threads
 from stage_sim.sim.collision import Bodies, CollisionChecker, GridFrame
+from stage_sim.sim.drives import group_by_drive
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, mark_numba_loaded, upgrade_wanted
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import draw_odom_errors, integrate_odometry, relative_pose
@@ -76,7 +77,7 @@ class Simulation:
             mark_numba_loaded()
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
-        self._drives = np.array([r.drive_code for r in self.robots], dtype=np.int64)
+        self._drives = group_by_drive([r.settings.drive for r in self.robots])
         self._wheelbases = np.array([r.settings.wheelbase for r in self.robots], dtype=np.float64)
         self._bounds = np.array([r.settings.velocity_bounds for r in self.robots], dtype=np.float64).reshape(n, 8)
         self._uses_odom = np.array([r.settings.localization == "odom" for r in self.robots], dtype=bool)

@@ -13,7 +13,7 @@ from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
 
 # Two touching robots with lasers in a walled box: every kernel (both ray-casting loops, robot cells,
-# collision) runs at least once.
+# collision) runs at least once; the motion kernels of every drive run through motion_kernels.warm.
 WORLD = """
 define laser ranger ( sensor( range [0 2] fov 180 samples 5 ) )
 define bot position ( size [0.4 0.3 0.2] localization "odom" laser( ) )
@@ -27,6 +27,9 @@ def warm() -> None:
     """Run every kernel once on a tiny world (compiling what the cache lacks)."""
     if not numba_available():
         return
+    from stage_sim.sim import motion_kernels  # imports numba: only once it is known to load
+
+    motion_kernels.warm(2)
     sim = Simulation(load_world_text(WORLD, "warm_up.world"), seed=0, kernels="numba")
     sim.set_velocity(0, 0.5, 0.0, 0.5)
     sim.step()

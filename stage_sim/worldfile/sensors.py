@@ -9,10 +9,10 @@ from __future__ import annotations
 import math
 
 from stage_sim.worldfile.description import Pose, PositionSettings, Sensor
+from stage_sim.worldfile.drive_names import DRIVE_NAMES
 from stage_sim.worldfile.errors import SourceLocation
 from stage_sim.worldfile.keys import Properties
 
-DRIVES = ("diff", "omni", "car")
 LOCALIZATIONS = ("gps", "odom")
 RANGER_LEVEL_KEYS = ("range", "fov", "samples", "noise")
 """Sensor keys that Stage 4 reads only inside ``sensor( )`` but old worlds put on the ranger itself."""
@@ -133,7 +133,7 @@ def position_settings(props: Properties) -> PositionSettings:
     if "wheelbase" in props:
         props.require(wheelbase > 0, "wheelbase", wheelbase, "a wheelbase > 0 m")
     return PositionSettings(
-        drive=props.choice("drive", defaults.drive, DRIVES),
+        drive=props.choice("drive", defaults.drive, DRIVE_NAMES),
         velocity_bounds=bounds["velocity_bounds"],
         acceleration_bounds=bounds["acceleration_bounds"],
         localization=props.choice("localization", defaults.localization, LOCALIZATIONS),

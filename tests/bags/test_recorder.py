@@ -178,18 +178,37 @@ def test_unknown_topic_and_unwritable_path_are_errors_before_any_step(tmp_path) 
         BagRecorder(sim, tmp_path / "x.bag", names_of(sim))
 
 
-def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp_path, monkeypatch) -> None:
-    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
-    path = tmp_path / "slow.mcap"
-    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)  # the smallest queue: 16 steps
-    recorder = BagRecorder(sim, path, names_of(sim))
+def slow_recorder(sim: Simulation, path: Path, monkeypatch: pytest.MonkeyPatch, lossless: bool) -> BagRecorder:
+    """A recorder with the smallest queue (16 steps) on a disk that takes 2 ms per message (24 ms per step of
+    the two-robot world), far slower than the simulation."""
+    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)
+    recorder = BagRecorder(sim, path, names_of(sim), lossless=lossless)
     write = recorder._bag.write
 
-    def slow_write(*args) -> None:  # a disk that takes 2 ms per message: 24 ms per step of this world
+    def slow_write(*args) -> None:
         time.sleep(0.002)
         write(*args)
 
     monkeypatch.setattr(recorder._bag, "write", slow_write)
+    return recorder
+
+
+def test_a_lossless_recording_waits_for_a_slow_writer_and_records_every_step(tmp_path, monkeypatch) -> None:
+    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
+    path = tmp_path / "slow.mcap"
+    recorder = slow_recorder(sim, path, monkeypatch, lossless=True)
+    for _ in range(60):
+        sim.step()
+        recorder.record_step()
+    summary = recorder.close()
+    assert (summary.dropped_steps, summary.messages, summary.complete) == (0, 1 + 60 * 12, True)
+    assert READERS["mcap"](path).counts()["/clock"] == 60
+
+
+def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp_path, monkeypatch) -> None:
+    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
+    path = tmp_path / "slow.mcap"
+    recorder = slow_recorder(sim, path, monkeypatch, lossless=False)
     longest = 0.0
     for _ in range(150):
         sim.step()
@@ -197,7 +216,7 @@ def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp
         recorder.record_step()
         longest = max(longest, time.perf_counter() - start)
     summary = recorder.close()
-    assert summary.dropped_steps > 0 and longest < 0.05
+    assert summary.dropped_steps > 0 and longest < 0.05 and not summary.complete
     assert summary.messages + summary.dropped_messages == 1 + 150 * 12
     assert f"dropped {summary.dropped_messages} messages of {summary.dropped_steps} steps" in summary.describe()
     bag = READERS["mcap"](path)
@@ -206,3 +225,29 @@ def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp
         (record,) = [m for m in make_reader(stream).iter_metadata() if m.name == "stage_sim"]
     assert record.metadata == {"dropped_steps": str(summary.dropped_steps),
                                "dropped_messages": str(summary.dropped_messages)}
+
+
+@pytest.mark.parametrize(("speedup", "status"), [("0", 0), ("20", 1)])
+def test_stage_sim_run_records_every_step_unless_paced_and_says_so_by_its_status(
+        tmp_path, monkeypatch, capsys, speedup, status) -> None:
+    """Unpaced (``--speedup 0``) the run waits for a slow writer; paced to the wall clock it drops steps
+    and exits 1, naming the cause."""
+    from stage_sim.bags.container import McapBag
+    from stage_sim.cli import main
+
+    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)
+    write = McapBag.write
+
+    def slow_write(self, *args) -> None:
+        time.sleep(0.002)
+        write(self, *args)
+
+    monkeypatch.setattr(McapBag, "write", slow_write)
+    path = tmp_path / "run.mcap"
+    assert main(["run", str(two_robot_world(tmp_path)), "--duration", "4", "--speedup", speedup,
+                 "--bag", str(path)]) == status
+    clocks = READERS["mcap"](path).counts()["/clock"]
+    if status == 0:
+        assert clocks == 40
+    else:
+        assert clocks < 40 and "could not keep up" in capsys.readouterr().err

@@ -28,7 +28,7 @@ def drive(path: str) -> dict:
     start = sim.true_poses.copy()
     for _ in range(STEPS):
         for index, robot in enumerate(sim.robots):
-            sim.set_velocity(index, FORWARD, SIDEWAYS if robot.settings.drive == "omni" else 0.0, TURN)
+            sim.set_velocity(index, FORWARD, SIDEWAYS if robot.drive.holonomic else 0.0, TURN)
         sim.step()
     scans = [scan for robot_scans in sim.scans for scan in robot_scans]
     moved = np.any(sim.true_poses != start, axis=1)

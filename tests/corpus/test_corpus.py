@@ -11,13 +11,20 @@ import json
 import pytest
 
 from tests.corpus.children import CPU_BUDGET_S, LOCATED_MESSAGE, python_command, run_limited
-from tests.corpus.worlds_list import FAILS_TO_LOAD, OWN_WORLDS, World, params, require_corpus
+from tests.corpus.worlds_list import CORPUS, FAILS_TO_LOAD, OWN_WORLDS, World, params, worlds
 
 DRIVER = str(OWN_WORLDS.parent / "drive_world.py")
 
 
-def test_the_corpus_is_there() -> None:
-    require_corpus()
+def test_the_corpus_travels_with_the_repository() -> None:
+    """Stage's and stage_ros' worlds are in tests/data/corpus (a clone needs nothing beside it), every world
+    expected to fail names a file that is there, and the licences of both origins are kept with them."""
+    ids = {world.id for world in worlds()}
+    assert sum(i.startswith("stage-worlds/") for i in ids) >= 29
+    assert sum(i.startswith("stage_ros-world/") for i in ids) >= 5
+    assert set(FAILS_TO_LOAD) <= ids
+    assert (CORPUS / "stage-worlds" / "COPYING.txt").read_text().lstrip().startswith("GNU GENERAL PUBLIC LICENSE")
+    assert "Licence" in (CORPUS / "README.md").read_text()
 
 
 @pytest.mark.parametrize("world", params())

@@ -1,6 +1,6 @@
 """Golden scans recorded from Stage 4.3, and stage_sim's scans at the same poses.
 
-``../shared/fidelity/rooms_<V>.jsonl`` (beside the repository, or in $STAGE_SIM_FIDELITY; its README says
+``tests/data/fidelity/rooms_<V>.jsonl`` (copied from the project's ``../shared/fidelity``; its README says
 how each world and pose is made) holds, per line, a robot pose in ``worlds/rooms.world`` and the first
 laser scan Stage computed there. Variant A is the world as it is, B has ``resolution 0.05``, C the
 floorplan turned by 30°.
@@ -14,7 +14,6 @@ what stage_sim itself returns.
 from __future__ import annotations
 
 import json
-import os
 import re
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -31,16 +30,7 @@ from tests.maps.stage_raytrace import stage_ray_ranges
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _recordings() -> Path:
-    """$STAGE_SIM_FIDELITY, else ``shared/fidelity`` beside the repository (as CI clones it) or beside one of
-    its parent directories (a working clone kept in a subdirectory of the project)."""
-    if "STAGE_SIM_FIDELITY" in os.environ:
-        return Path(os.environ["STAGE_SIM_FIDELITY"])
-    beside = [parent / "shared" / "fidelity" for parent in REPO.parents]
-    return next((path for path in beside if path.is_dir()), beside[0])
-
-
-FIDELITY = _recordings()
+FIDELITY = REPO / "tests" / "data" / "fidelity"
 WORLD = REPO / "worlds" / "rooms.world"
 VARIANTS = ("A", "B", "C")
 #: How each variant changes rooms.world (the fidelity README's table).
@@ -86,8 +76,7 @@ def load_golden(variant: str) -> list[GoldenScan]:
     path = FIDELITY / f"rooms_{variant}.jsonl"
     if not path.is_file():
         raise FileNotFoundError(
-            f"golden scans not found: {path} (clone the repository with shared/ beside it, as CI does, "
-            "or set STAGE_SIM_FIDELITY to the directory holding rooms_A.jsonl)")
+            f"golden scans not found: {path} (they are part of the repository: restore tests/data/fidelity)")
     scans = []
     with open(path, encoding="utf-8") as lines:
         for line in lines:

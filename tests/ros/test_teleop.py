@@ -196,11 +196,21 @@ def test_stamped_publishes_twist_stamped_in_frame(teleop_factory) -> None:
     assert (msg.header.stamp.sec, msg.header.stamp.nanosec) != (0, 0)
 
 
-def test_frame_id_without_stamped_is_an_error(ros_context: Context, capfd) -> None:
+def test_frame_id_without_stamped_is_an_error(ros_context: Context, capfd, monkeypatch) -> None:
     with pytest.raises(ValueError, match="frame_id"):
         TeleopTwistKeyboard(context=ros_context, parameter_overrides=[Parameter("frame_id", value="base_link")])
-    assert main(["teleop", "--ros-args", "-p", "frame_id:=base_link"]) == 2
+    master, slave = pty.openpty()
+    with os.fdopen(slave, "r") as terminal:
+        monkeypatch.setattr(sys, "stdin", terminal)
+        assert main(["teleop", "--ros-args", "-p", "frame_id:=base_link"]) == 2
+    os.close(master)
     assert "'frame_id' can only be set when 'stamped' is true" in capfd.readouterr().err
+
+
+def test_without_a_terminal_it_says_so_and_fails(capfd, monkeypatch) -> None:
+    monkeypatch.setattr(sys, "stdin", io.StringIO("i"))
+    assert main(["teleop"]) == 2
+    assert "needs a terminal" in capfd.readouterr().err
 
 
 def test_key_reader_on_plain_streams_uses_no_termios() -> None:

@@ -8,7 +8,7 @@ import numpy as np
 
 from stage_sim.runs.driver import WanderDriver
 from stage_sim.sim.simulation import Simulation
-from stage_sim.worldfile.loader import load_world
+from stage_sim.worldfile.loader import load_world, load_world_text
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -32,3 +32,15 @@ def test_scan_fields_are_the_float32_values_a_laser_scan_carries() -> None:
                          (reading.angle_increment, sensor.fov / (sensor.samples - 1))):
         assert value == float(np.float32(exact))
     assert reading.laser_pose[:2] == (sim.robots[0].rangers[0].pose.x, sim.robots[0].rangers[0].pose.y)
+
+
+def test_only_robots_with_a_holonomic_drive_get_a_wanderer_that_moves_sideways() -> None:
+    world = load_world_text("""
+define laser ranger ( sensor( range [0 4] fov 180 samples 9 ) )
+define bot position ( size [0.4 0.3 0.2] laser( ) )
+bot( pose [1 1 0 0] drive "diff" )
+bot( pose [3 1 0 0] drive "omni" )
+bot( pose [5 1 0 0] drive "car" )
+""", "drives.world")
+    driver = WanderDriver(Simulation(world, seed=1, kernels="numpy"), seed=1)
+    assert [driver.wanderers[i].config.holonomic for i in range(3)] == [False, True, False]

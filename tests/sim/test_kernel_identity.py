@@ -12,6 +12,7 @@ import pytest
 
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import bundled_worlds, data_root
+from stage_sim.worldfile.drive_names import DRIVE_NAMES
 from stage_sim.worldfile.loader import load_world, load_world_text
 
 WORLD = """
@@ -36,7 +37,7 @@ def crowd_world(seed: int) -> str:
     lines = []
     for i in range(14):
         x, y = 1.0 + (i % 7) * 0.42, 1.0 + (i // 7) * 0.33
-        drive = ("diff", "omni", "car")[i % 3]
+        drive = DRIVE_NAMES[i % len(DRIVE_NAMES)]
         extra = ' size [0.4 0.3 0.05]' if i % 5 == 4 else ""
         lines.append(f'bot( pose [{x:.3f} {y:.3f} 0 {rng.uniform(-20, 20):.1f}] drive "{drive}"{extra} )')
     lines.append('bot( pose [4.5 3.5 0 30] odom_error [0.1 0.05 0 0.2] )')

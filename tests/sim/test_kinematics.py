@@ -7,13 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from stage_sim.sim.kinematics import DRIVE_CODES, body_velocity, integrate, normalize_angle
+from stage_sim.sim.drives import group_by_drive
+from stage_sim.sim.kinematics import body_velocity, integrate, normalize_angle
 
 DEFAULT_BOUNDS = np.array([[-1, 1, -1, 1, -1, 1, -math.pi / 2, math.pi / 2]], dtype=float)
 
 
 def velocity(command, drive, wheelbase=1.0, bounds=DEFAULT_BOUNDS):
-    return body_velocity(np.array([command], float), np.array([DRIVE_CODES[drive]]), np.array([wheelbase]), bounds)[0]
+    return body_velocity(np.array([command], float), group_by_drive([drive]), np.array([wheelbase]), bounds)[0]
 
 
 def test_diff_ignores_lateral_command() -> None:

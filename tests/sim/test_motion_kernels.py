@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from stage_sim.sim import motion_kernels
+from stage_sim.sim.drives import DRIVES, group_by_drive
 from stage_sim.sim.kinematics import body_velocity, integrate, normalize_angle
 from stage_sim.sim.odometry import integrate_odometry
 
@@ -30,7 +31,7 @@ def test_body_velocities_match_the_reference(seed):
     rng = np.random.default_rng(seed)
     commands = rng.uniform(-3, 3, (N, 3))
     commands[rng.random((N, 3)) < 0.2] = 0.0
-    drives = rng.integers(0, 3, N)
+    drives = group_by_drive(rng.choice(list(DRIVES), N))
     wheelbases = rng.uniform(0.1, 1.0, N)
     low = -rng.uniform(0, 2, (N, 4))
     bounds = np.stack([low[:, 0], -low[:, 0], low[:, 1], -low[:, 1], low[:, 2], -low[:, 2], low[:, 3], -low[:, 3]],
