@@ -10,7 +10,7 @@ PYTEST_ARGS ?=
 # Keep DDS discovery on loopback unless the user chose otherwise (project rule for every process).
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 
-.PHONY: setup run test lint bench clean-venv
+.PHONY: setup run test lint bench docs clean-venv
 
 WORLD ?= worlds/rooms.world
 RUN_ARGS ?=
@@ -49,24 +49,46 @@ run: setup
 test: setup
 	$(PY) -m pytest $(PYTEST_ARGS)
 
-# Every row of issue #14's table: rays/s; both laser cases for 1-1000 robots (numba on one core, numba on 2
-# threads, numpy on one core at 1 and 100 robots, for the ratio; one configuration per process, so that each
-# peak_rss_mb is its own); stageros --speedup 0; start to first scan; the two large worlds (and the RL one on 2
-# threads).
+# make bench: every benchmark script, its JSON lines written to docs/data/bench/<script>.jsonl and the command
+# that produced them to <script>.command; the docs build turns those files into the performance and fidelity
+# tables (tools/docs_tables.py). `make bench QUICK=1` runs the short versions (fewer seconds, seeds and repeats).
+# One configuration per process where peak RSS is reported, so that each peak_rss_mb is its own.
+BENCH_DATA := docs/data/bench
 SHORT_LASER := --beams 240 --fov 240 --range 5.6
 LONG_LASER := --beams 1081 --fov 270 --range 30
+QUICK ?=
+pick = $(if $(QUICK),$(2),$(1))
+SIM_SECONDS := $(call pick,,--seconds 3)
+# $(call bench_run,NAME,COMMAND): COMMAND is written with `python` for the venv's interpreter.
+define bench_run
+	@echo '$(strip $(2))' >> $(BENCH_DATA)/$(1).command
+	set -o pipefail; $(subst python ,$(PY) ,$(2)) | tee /dev/stderr | grep '^{' >> $(BENCH_DATA)/$(1).jsonl
+
+endef
+
 bench: setup
-	$(PY) benchmarks/raycast.py
-	for laser in "$(SHORT_LASER)" "$(LONG_LASER)"; do \
-	  $(PY) benchmarks/simulate.py $$laser --kernels numba --threads 1 --robots 1 10 100 1000 && \
-	  $(PY) benchmarks/simulate.py $$laser --kernels numba --threads 2 --robots 1 10 100 1000 && \
-	  $(PY) benchmarks/simulate.py $$laser --kernels numpy --threads 1 --robots 1 100 || exit 1; \
-	done
-	$(PY) benchmarks/stageros.py
-	$(PY) benchmarks/startup.py
-	taskset -c 0 $(PY) benchmarks/worlds.py
-	$(PY) benchmarks/worlds.py --worlds rl --threads 2
-	taskset -c 0 $(PY) benchmarks/jump_chain.py
+	@mkdir -p $(BENCH_DATA) && rm -f $(BENCH_DATA)/*.jsonl $(BENCH_DATA)/*.command
+	@printf '{"cores": %s, "cpu": "%s", "quick": %s}\n' "$$(nproc)" \
+	  "$$(lscpu | sed -n 's/^Model name: *//p' | head -1)" "$(if $(QUICK),true,false)" > $(BENCH_DATA)/machine.json
+	$(call bench_run,raycast,python benchmarks/raycast.py)
+	$(foreach laser,SHORT_LASER LONG_LASER,\
+	  $(call bench_run,simulate,python benchmarks/simulate.py $($(laser)) --kernels numba --threads 1 --robots 1 10 100 1000 $(SIM_SECONDS))\
+	  $(call bench_run,simulate,python benchmarks/simulate.py $($(laser)) --kernels numba --threads 2 --robots 1 10 100 1000 $(SIM_SECONDS))\
+	  $(call bench_run,simulate,python benchmarks/simulate.py $($(laser)) --kernels numpy --threads 1 --robots 1 100 $(SIM_SECONDS)))
+	$(call bench_run,stageros,python benchmarks/stageros.py $(call pick,,--seconds 5))
+	$(call bench_run,startup,python benchmarks/startup.py $(call pick,,--runs 1))
+	$(call bench_run,worlds,taskset -c 0 python benchmarks/worlds.py $(call pick,,--seconds 2))
+	$(call bench_run,worlds,python benchmarks/worlds.py --worlds rl --threads 2 $(call pick,,--seconds 2))
+	$(call bench_run,jump_chain,taskset -c 0 python benchmarks/jump_chain.py)
+	$(call bench_run,bags,python benchmarks/bags.py $(call pick,,--duration 60 --repeat 1))
+	$(call bench_run,envs,taskset -c 0 python benchmarks/envs.py $(call pick,,--seconds 3 --episodes 3))
+	$(call bench_run,fidelity,python benchmarks/fidelity.py)
+	$(call bench_run,wander_speed,taskset -c 0 python benchmarks/wander_speed.py $(call pick,,--steps 300))
+	$(call bench_run,wander_sweep,python benchmarks/wander_sweep.py --core --world rooms.world $(call pick,--seeds 20 --minutes 30,--seeds 2 --minutes 30 --jobs 1))
+
+# The documentation site (mkdocs.yml, docs/) into site/, in strict mode: a broken link, reference or table fails.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
 
 lint: setup
 	$(VENV)/bin/ruff check stage_sim tests benchmarks tools launch_scripts

@@ -62,7 +62,7 @@ def first_scan(env: dict[str, str], timeout: float = 120.0) -> tuple[float, floa
             executor.spin_once(timeout_sec=0.01)
     finally:
         process.terminate()
-        process.wait(timeout=20)
+        process.wait(timeout=timeout)  # a stageros stopped while numba compiles exits once the compiler is done
         node.destroy_node()
         rclpy.shutdown()
     if not got:

@@ -1,0 +1,1 @@
+taskset -c 0 python benchmarks/envs.py --seconds 3 --episodes 3

@@ -1,0 +1,1 @@
+taskset -c 0 python benchmarks/jump_chain.py

@@ -1,0 +1,1 @@
+python benchmarks/stageros.py --seconds 5

@@ -1,0 +1,1 @@
+python benchmarks/startup.py --runs 1

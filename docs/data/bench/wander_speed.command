@@ -1,0 +1,1 @@
+taskset -c 0 python benchmarks/wander_speed.py --steps 300

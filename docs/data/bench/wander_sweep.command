@@ -1,0 +1,1 @@
+python benchmarks/wander_sweep.py --core --world rooms.world --seeds 2 --minutes 30 --jobs 1
