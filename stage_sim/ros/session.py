@@ -68,11 +68,11 @@ class WanderSession:
         stop = stop or threading.Event()
         self._connect()
         stage = self.stage
-        lockstep = stage.speedup <= 0
+        lockstep = stage.pacer.speedup <= 0
         if not lockstep:
             stage.start_stepping()
         while not stage.finished and not stop.is_set():
-            if lockstep and not stage.paused:
+            if lockstep and not stage.pacer.paused:
                 stage.step_once()
                 self._await_answers()
             else:

@@ -117,7 +117,7 @@ class StageRos(Node):
         self.rivals = RivalPublishers(self, ["/clock"], [t for n in self.names for t in (n.odom, *n.scans[:1])])
         self.get_logger().info(
             f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
-            f"speedup {self.speedup:g}" + (" (as fast as possible)" if self.speedup <= 0 else ""))
+            f"speedup {speedup:g}" + (" (as fast as possible)" if speedup <= 0 else ""))
 
     # -- set-up --------------------------------------------------------------------------------------------
 
@@ -160,16 +160,6 @@ class StageRos(Node):
         for subscription in list(self.subscriptions):
             self.destroy_subscription(subscription)
         super().destroy_node()
-
-    @property
-    def speedup(self) -> float:
-        """Sim seconds per wall second (``<= 0``: as fast as possible)."""
-        return self.pacer.speedup
-
-    @property
-    def paused(self) -> bool:
-        """Stepping stopped (the browser view's pause)."""
-        return self.pacer.paused
 
     def _step_timer(self, start: bool) -> Timer:
         """The steady wall timer that wakes the node every step period (0: at every executor round)."""
@@ -224,7 +214,7 @@ class StageRos(Node):
     def start_stepping(self) -> None:
         """Step on the node's own timer from now on (for callers that built it with ``autostep=False``)."""
         self.autostep = True
-        self.set_paused(self.paused)
+        self.set_paused(self.pacer.paused)
 
     def set_paused(self, paused: bool) -> None:
         """Stop or resume stepping (the browser view's pause): sim time and /clock stand still meanwhile."""
@@ -239,11 +229,11 @@ class StageRos(Node):
         """Step at a new real-time factor from now on (``<= 0``: as fast as possible)."""
         self.pacer.set_speedup(speedup)
         self.destroy_timer(self._timer)
-        self._timer = self._step_timer(self.autostep and not self.paused and not self.finished)
+        self._timer = self._step_timer(self.autostep and not self.pacer.paused and not self.finished)
 
     def step_once(self) -> None:
         """One simulation step and everything it publishes (none while paused)."""
-        if self.finished or self.paused:
+        if self.finished or self.pacer.paused:
             return
         self.sim.step()
         self._publish_step()

@@ -13,6 +13,7 @@ import sys
 import time
 from typing import TYPE_CHECKING, Protocol
 
+from stage_sim.runs.pacing import Pacer
 from stage_sim.view.frames import FrameSampler
 from stage_sim.view.messages import Action, Drive, MessageReader, Pause, Place, Speed
 from stage_sim.view.scene import Scene, robot_names
@@ -25,8 +26,8 @@ if TYPE_CHECKING:
 class Controls(Protocol):
     """What a page may do, as the host of the simulation does it (called between steps only)."""
 
-    paused: bool
-    speedup: float
+    pacer: Pacer
+    """The run's schedule: whether it is paused and at what speedup (changed only through the methods below)."""
 
     def drive(self, robot: int, vx: float, vy: float, va: float) -> None:
         """A velocity command, exactly as one from ``cmd_vel``."""
@@ -80,7 +81,8 @@ class LiveView:
             return
         now = time.monotonic()
         if self.sampler.due(now):
-            frame = self.sampler.take(now, self.controls.paused, self.controls.speedup, force=self._changed)
+            pacer = self.controls.pacer
+            frame = self.sampler.take(now, pacer.paused, pacer.speedup, force=self._changed)
             self._changed = False
             if frame is not None:
                 self.server.publish(frame)

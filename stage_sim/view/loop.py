@@ -34,14 +34,6 @@ class PacedLoop:
         self.pacer = Pacer(sim.interval, speedup, lambda: sim.sim_time, end)
         self.before_step = before_step
 
-    @property
-    def paused(self) -> bool:
-        return self.pacer.paused
-
-    @property
-    def speedup(self) -> float:
-        return self.pacer.speedup
-
     def drive(self, robot: int, vx: float, vy: float, va: float) -> None:
         self.sim.set_velocity(robot, vx, vy, va)
 
