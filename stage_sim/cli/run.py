@@ -46,12 +46,12 @@ def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
     from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
-    from stage_sim.runs.pacing import Pacer, run_end, threads_for_run
+    from stage_sim.runs.pacing import Pacer, run_end, run_speedup, threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(resolve_world(args.world))
-    speedup = description.settings.speedup if args.speedup is None else args.speedup
+    speedup = run_speedup(args.speedup, description.settings.speedup)
     threads = threads_for_run(args.threads, speedup)
     sim = Simulation(description, seed=args.seed, kernels=args.kernels, threads=threads)
     for warning in sim.warnings:

@@ -26,13 +26,13 @@ from stage_sim.view.options import add_view_arguments
 
 
 def run(args: argparse.Namespace) -> int:
-    from stage_sim.runs.pacing import run_end, threads_for_run
+    from stage_sim.runs.pacing import run_end, run_speedup, threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.view import LiveView, PacedLoop, view_settings
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(resolve_world(args.world))
-    speedup = description.settings.speedup if args.speedup is None else args.speedup
+    speedup = run_speedup(args.speedup, description.settings.speedup)
     sim = Simulation(description, seed=args.seed, watchdog_timeout=args.watchdog, kernels=args.kernels,
                      threads=threads_for_run(args.threads, speedup))
     for warning in sim.warnings:

@@ -37,7 +37,7 @@ from stage_sim.bags.names import RobotNames, robot_names
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
 from stage_sim.ros.rival_publishers import RivalPublishers
-from stage_sim.runs.pacing import WATCHDOG_S, Pacer, run_end, threads_for_run
+from stage_sim.runs.pacing import WATCHDOG_S, Pacer, run_end, run_speedup, threads_for_run
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world
 from stage_sim.worldfile.loader import load_world
@@ -89,7 +89,7 @@ class StageRos(Node):
             raise ValueError("no world given: pass WORLD on the command line or set the 'world_file' parameter")
         description = load_world(find_world(world_param))
         self.world_path = description.path
-        speedup_default = description.settings.speedup if speedup is None else speedup
+        speedup_default = run_speedup(speedup, description.settings.speedup)
         speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
         seed_value = int(self.declare_parameter("seed", -1 if seed is None else seed).value)
         watchdog = float(self.declare_parameter("base_watchdog_timeout", WATCHDOG_S).value)

@@ -32,6 +32,11 @@ END_TOLERANCE_S = 1e-9
 """Sim times this close below the end count as the end (sim time is a sum of float intervals)."""
 
 
+def run_speedup(requested: float | None, world_speedup: float) -> float:
+    """The speedup of a run: the user's (``--speedup``, a parameter), else the world's ``speedup``."""
+    return world_speedup if requested is None else requested
+
+
 def run_end(quit_time: float, duration: float | None = None) -> float:
     """The sim time a run ends at: the earlier of the world's ``quit_time`` (``<= 0``: none) and ``duration``
     (None: none); infinity when neither is set (the run goes on until stopped)."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 
 from stage_sim.runs import pacing
-from stage_sim.runs.pacing import FAST_BATCH_S, MAX_LAG_S, Pacer, run_end
+from stage_sim.runs.pacing import FAST_BATCH_S, MAX_LAG_S, Pacer, run_end, run_speedup
 from stage_sim.sensing.kernels import THREADS_ENV
 
 INTERVAL = 0.125  # exact in binary, as are the wall times below
@@ -71,6 +71,12 @@ def test_a_paused_run_takes_no_step_and_resumes_without_debt() -> None:
     assert run.take(pacer) == 1
     assert run.take(pacer) == 0
     assert run.sim_time == 2 * INTERVAL
+
+
+def test_the_users_speedup_else_the_worlds() -> None:
+    assert run_speedup(None, world_speedup=0.0) == 0.0
+    assert run_speedup(4.0, world_speedup=0.0) == 4.0
+    assert run_speedup(-1.0, world_speedup=2.0) == -1.0
 
 
 def test_the_run_ends_at_the_earlier_of_quit_time_and_duration() -> None:
