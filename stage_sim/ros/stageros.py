@@ -113,6 +113,7 @@ class StageRos(Node):
         self._step_listeners: list[Callable[[], None]] = []
         self.autostep = autostep
         self._timer = self._step_timer(autostep)
+        self._catch_up = self.create_guard_condition(self._step_due)
         self._publish_static()
         self.rivals = RivalPublishers(self, ["/clock"], [t for n in self.names for t in (n.odom, *n.scans[:1])])
         self.get_logger().info(
@@ -167,9 +168,11 @@ class StageRos(Node):
             self.pacer.period, self._step_due, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
 
     def _step_due(self) -> None:
-        """The steps the pacer says are due now."""
+        """The steps the pacer says are due now; a node woken late comes back after the callbacks waiting."""
         for _ in self.pacer.steps():
             self.step_once()
+        if self.pacer.behind():
+            self._catch_up.trigger()
 
     def _robot_publisher(self, msg_type: type, topic: str) -> Publisher:
         return self.create_publisher(msg_type, topic, RELIABLE_10, event_callbacks=NO_PUB_EVENTS)

@@ -22,9 +22,9 @@ from stage_sim.sensing.kernels import resolve_threads
 MAX_LAG_S = 1.0
 """A loop further behind its schedule than this (a stalled machine) starts afresh rather than catch up."""
 FAST_BATCH_S = 0.002
-"""Wall seconds of back-to-back steps before the loop's host gets a turn (at least one step per turn): with
-``speedup <= 0``, and while a paced run catches up. One ROS executor round costs about as much as a step of
-a small world, so commands, resets and a view still get in hundreds of times a second."""
+"""Wall seconds of back-to-back steps with ``speedup <= 0`` before the loop's host gets a turn (at least one
+step per turn). One ROS executor round costs about as much as a step of a small world, so commands, resets
+and a view still get in hundreds of times a second."""
 WATCHDOG_S = 0.2
 """Sim seconds a velocity command lasts without a new one: stageros' ``base_watchdog_timeout`` default, which
 ``stage_sim view`` and the sessions use too (``<= 0``: forever)."""
@@ -70,24 +70,32 @@ class Pacer:
         return self.sim_time() >= self.end - END_TOLERANCE_S
 
     def steps(self) -> Iterator[None]:
-        """Yield once per step to take now (the caller steps, then resumes the iteration), for at most
-        FAST_BATCH_S of wall time but at least one step: every step the schedule has reached, or with
-        ``speedup <= 0`` steps back to back. A schedule more than MAX_LAG_S behind starts afresh from now.
-        Nothing while paused or finished."""
+        """Yield once per step to take now (the caller steps, then resumes the iteration). Paced, one step
+        if the schedule has reached it: a late loop catches up turn by turn (:meth:`behind`), with its host's
+        work (commands above all, which the watchdog counts in sim time) in between; a schedule more than
+        MAX_LAG_S behind starts afresh from now. With ``speedup <= 0`` steps back to back for FAST_BATCH_S of
+        wall time, at least one. Nothing while paused or finished."""
         started = self.clock()
         taken = 0
         while not (self.paused or self.finished()):
             now = self.clock()
-            if taken and now - started >= FAST_BATCH_S:
-                return
             if self.speedup > 0:
+                if taken:
+                    return
                 if now - self._due > MAX_LAG_S:
                     self._due = now
                 if now < self._due:
                     return
                 self._due += self.period
+            elif taken and now - started >= FAST_BATCH_S:
+                return
             taken += 1
             yield
+
+    def behind(self) -> bool:
+        """A paced run already owes its next step: its host should come back as soon as its other work is
+        done rather than wait for its next regular wake-up."""
+        return self.speedup > 0 and not (self.paused or self.finished()) and self.clock() >= self._due
 
     def wait_s(self) -> float:
         """Wall seconds until the next step is due: 0 now (and once finished: the caller's loop ends),

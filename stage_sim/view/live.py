@@ -13,13 +13,13 @@ import sys
 import time
 from typing import TYPE_CHECKING, Protocol
 
-from stage_sim.runs.pacing import Pacer
 from stage_sim.view.frames import FrameSampler
 from stage_sim.view.messages import Action, Drive, MessageReader, Pause, Place, Speed
 from stage_sim.view.scene import Scene, robot_names
 from stage_sim.view.server import ViewServer, ViewSettings
 
 if TYPE_CHECKING:
+    from stage_sim.runs.pacing import Pacer
     from stage_sim.sim.simulation import Simulation
 
 
