@@ -3,8 +3,8 @@
 
 ``python launch_scripts/reactive.py [WORLD] [--speedup X] [--duration S] [--seed N] [--record OUT]
 [--bag OUT.mcap]`` runs the world (default ``rooms.world``) with a ``wander`` node per robot until
-``--duration`` sim seconds or Ctrl-C, then prints one JSON summary per robot: sim_seconds, distance_m,
-stall_events, longest_stop_s, coverage.
+``--duration`` sim seconds, the world's ``quit_time`` or Ctrl-C, then prints one JSON summary per robot:
+sim_seconds, distance_m, stall_events, longest_stop_s, coverage.
 ``--bag`` records every topic stageros publishes into a ROS 2 bag (MCAP), as ``stageros --bag`` does.
 ``--speedup 0`` runs in lockstep as fast as possible, reproducibly for a given ``--seed``.
 """

@@ -3,7 +3,8 @@
 
 ``python launch_scripts/teleop.py [WORLD] [--speedup X] [--duration S] [--seed N] [--record OUT]`` runs the
 world (default ``rooms.world``) and drives its first robot with teleop_twist_keyboard's keys typed on this
-terminal (``u i o / j k l / m , .``; Ctrl-C quits) until Ctrl-C or ``--duration`` sim seconds.
+terminal (``u i o / j k l / m , .``; Ctrl-C quits) until Ctrl-C, ``--duration`` sim seconds or the world's
+``quit_time``.
 """
 
 import os
@@ -39,14 +40,13 @@ def main(argv: list[str]) -> int:
 
     def spin() -> None:
         """Step the world until told to stop, the duration or the world's quit_time; then end the teleop too."""
-        while not done.is_set() and not stage.finished and (
-                args.duration is None or stage.sim.sim_time < args.duration - 1e-9):
+        while not done.is_set() and not stage.finished:
             executor.spin_once(timeout_sec=0.1)
         rclpy.try_shutdown()  # ends the teleop's key loop within its poll interval
 
     try:
         with sigterm_interrupts():
-            stage = StageRos(args.world, speedup=args.speedup, seed=args.seed)
+            stage = StageRos(args.world, speedup=args.speedup, seed=args.seed, duration=args.duration)
             nodes.append(stage)
             namespace = stage.names[0].cmd_vel[: -len("cmd_vel")].rstrip("/") if stage.names else ""
             teleop = TeleopTwistKeyboard(namespace=namespace or None)

@@ -2,9 +2,11 @@
 
 Dependencies point one way only, top to bottom (enforced by import-linter, ``.importlinter``)::
 
-    cli | ros                                   entry points; only ros imports rclpy
+    ros                                         ROS entry points and nodes; only ros imports rclpy
+    cli                                         ROS-free entry points, and the options every command shares
     envs                                        Gymnasium / PettingZoo environments
-    runs | rendering | view | bags              uses of a running simulation
+    rendering | view | bags                     uses of a running simulation
+    runs                                        how a run is paced, driven, measured and stopped
     wander                                      the reactive controller (never imports sim)
     sim                                         Simulation: robots, kinematics, odometry, collision
     sensing                                     ray casting on the grid, Stage's walk

@@ -7,6 +7,7 @@ by a page in Debian's headless Chromium; then pauses it, clicks the first robot 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import threading
 from pathlib import Path
@@ -15,6 +16,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from stage_sim.runs.driver import WanderDriver  # noqa: E402 (after the path is set)
+from stage_sim.runs.pacing import WATCHDOG_S  # noqa: E402
 from stage_sim.sim.simulation import Simulation  # noqa: E402
 from stage_sim.view import LiveView, PacedLoop, ViewSettings  # noqa: E402
 from tests.view.conftest import CHROMIUM, CHROMIUM_FLAGS  # noqa: E402
@@ -32,12 +34,12 @@ def main() -> int:
         return 1
     from playwright.sync_api import sync_playwright
 
-    sim = Simulation.from_world(args.world, seed=args.seed, watchdog_timeout=0.2)
-    loop = PacedLoop(sim, 4.0, WanderDriver(sim, args.seed).decide)
+    sim = Simulation.from_world(args.world, seed=args.seed, watchdog_timeout=WATCHDOG_S)
+    loop = PacedLoop(sim, 4.0, WanderDriver(sim, args.seed).decide, end=args.sim_seconds)
     view = LiveView(sim, loop, ViewSettings(port=0))
     url = view.start()
     stop = threading.Event()
-    runner = threading.Thread(target=loop.run, args=(stop, view, args.sim_seconds))
+    runner = threading.Thread(target=loop.run, args=(stop, view))
     runner.start()
     # The page watches the run from its start, so that it draws the trail too; then the world pauses.
     with sync_playwright() as playwright:
@@ -46,6 +48,7 @@ def main() -> int:
         page.goto(url)
         runner.join()
         loop.set_paused(True)
+        loop.pacer.end = math.inf  # no more steps while paused; the loop goes on serving the view
         final = threading.Thread(target=loop.run, args=(stop, view))  # serves the paused world's last frame
         final.start()
         page.wait_for_function("t => stageView.state.drawnFrame.paused && stageView.state.drawnFrame.time >= t",

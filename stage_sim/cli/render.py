@@ -7,9 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from stage_sim.cli.arguments import count, image_path, positive
+from stage_sim.cli.arguments import add_kernel_arguments, add_seed_argument, count, image_path, positive
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
-from stage_sim.sensing.kernels import add_kernel_arguments
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,8 +50,8 @@ def add_command(subparsers: Any) -> None:
     parser.add_argument("--scale", type=positive, help="pixels per metre (default: the world's window scale)")
     parser.add_argument("--no-lasers", action="store_true", help="do not draw the laser rays")
     parser.add_argument("--grid", action="store_true", help="draw a 1 m grid")
-    parser.add_argument("--seed", type=int, default=0, help="simulation (and wanderer) seed (default: 0)")
-    add_kernel_arguments(parser)
+    add_seed_argument(parser, default=0)
+    add_kernel_arguments(parser, paced=False)
     parser.add_argument("--steps", type=count, default=0, help="steps to simulate first (default: 0)")
     parser.add_argument(
         "--controller", choices=sorted(CONTROLLERS), default="straight",

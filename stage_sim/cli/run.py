@@ -1,10 +1,11 @@
-"""``stage_sim run WORLD --duration S [--bag OUT.mcap]``: step a world without ROS, optionally into a ROS 2 bag.
+"""``stage_sim run WORLD [--duration S] [--bag OUT.mcap]``: step a world without ROS, optionally into a ROS 2 bag.
 
 The bag holds what ``stageros --bag`` records for the same world, seed and commands (same topics, frames,
-types, QoS and field values) but comes from the core alone: no rclpy, no ROS install. The run ends at
-``--duration`` sim seconds, at the world's ``quit_time`` or on Ctrl-C / SIGTERM; each finalises the bag.
-Exit status 0 (also after Ctrl-C during the run), 1 when the bag misses steps (dropped at real time) or
-could not be written to the end, 2 for bad input, 130 for Ctrl-C before the first step.
+types, QoS and field values) but comes from the core alone: no rclpy, no ROS install. Steps are paced as
+every entry point paces them (:class:`~stage_sim.runs.pacing.Pacer`). The run ends at ``--duration`` sim
+seconds or the world's ``quit_time``, whichever comes first, or on Ctrl-C / SIGTERM; each finalises the bag.
+Exit status 0 (also after Ctrl-C during the run), 1 when the bag could not be written to the end, 2 for bad
+input, 130 for Ctrl-C before the first step.
 """
 
 from __future__ import annotations
@@ -16,10 +17,14 @@ import time
 from pathlib import Path
 from typing import Any
 
-from stage_sim.cli.arguments import positive
+from stage_sim.cli.arguments import (
+    add_duration_argument,
+    add_kernel_arguments,
+    add_seed_argument,
+    add_speedup_argument,
+)
 from stage_sim.cli.controllers import CONTROLLERS, STRAIGHT_SPEED
 from stage_sim.runs.interrupts import stop_requests
-from stage_sim.sensing.kernels import add_kernel_arguments
 
 
 def run(args: argparse.Namespace) -> int:
@@ -40,12 +45,12 @@ def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
     from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
-    from stage_sim.sensing.kernels import threads_for_run
+    from stage_sim.runs.pacing import Pacer, run_end, run_speedup, threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 
     description = load_world(args.world)
-    speedup = description.settings.speedup if args.speedup is None else args.speedup
+    speedup = run_speedup(args.speedup, description.settings.speedup)
     threads = threads_for_run(args.threads, speedup)
     sim = Simulation(description, seed=args.seed, kernels=args.kernels, threads=threads)
     for warning in sim.warnings:
@@ -60,20 +65,18 @@ def _run(args: argparse.Namespace) -> int:
         except (BagError, ValueError) as exc:
             print(f"stage_sim run: {exc}", file=sys.stderr)
             return 2
-    end = args.duration
-    if description.settings.quit_time > 0:
-        end = min(end, description.settings.quit_time)
+    pacer = Pacer(sim.interval, speedup, lambda: sim.sim_time, run_end(description.settings.quit_time, args.duration))
     drive = CONTROLLERS[args.controller](sim, args.seed)
     start = time.monotonic()
     try:
         with stop_requests() as stop:  # Ctrl-C and SIGTERM end the run between steps
-            while sim.sim_time < end - 1e-9 and not (recorder and recorder.failed) and not stop.is_set():
-                drive()
-                sim.step()
-                if recorder:
-                    recorder.record_step()
-                if speedup > 0:
-                    stop.wait(max(0.0, start + sim.sim_time / speedup - time.monotonic()))
+            while not (pacer.finished() or stop.is_set() or (recorder and recorder.failed)):
+                for _ in pacer.steps():
+                    drive()
+                    sim.step()
+                    if recorder:
+                        recorder.record_step()
+                stop.wait(pacer.wait_s())
         if stop.is_set():
             print(f"stage_sim run: interrupted at sim time {sim.sim_time:g} s", file=sys.stderr)
     finally:
@@ -90,19 +93,18 @@ def _run(args: argparse.Namespace) -> int:
 def add_command(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run", help="run a world without ROS for some sim time, optionally recording a ROS 2 bag (MCAP)",
-        description="Step a world for --duration sim seconds (or until its quit_time or Ctrl-C) with every robot "
-        "driven by --controller, and record with --bag what stageros would publish, into an MCAP bag that "
-        "rosbags, the mcap tools and 'ros2 bag' read. No ROS installation is needed.",
+        description="Step a world until --duration sim seconds or its quit_time, whichever comes first (neither: "
+        "until Ctrl-C), with every robot driven by --controller, and record with --bag what stageros would "
+        "publish, into an MCAP bag that rosbags, the mcap tools and 'ros2 bag' read. No ROS installation is needed.",
     )
     parser.add_argument("world", help="world file path, or the name of a bundled world")
-    parser.add_argument("--duration", type=positive, required=True, help="sim seconds to run")
-    parser.add_argument("--speedup", type=float, default=None,
-                        help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
+    add_duration_argument(parser)
+    add_speedup_argument(parser)
     parser.add_argument(
         "--controller", choices=sorted(CONTROLLERS), default="straight",
         help=f"who drives: 'straight' at {STRAIGHT_SPEED} m/s, or the wander node's strategy (default straight)")
-    parser.add_argument("--seed", type=int, default=None, help="simulation (and wanderer) seed")
-    add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
+    add_seed_argument(parser)
+    add_kernel_arguments(parser)
     parser.add_argument("-u", action="store_true", dest="use_model_names",
                         help="name robots' topics and frames after their models (as stageros -u)")
     parser.add_argument("--bag", type=Path, metavar="OUT.mcap", help="record a ROS 2 bag (MCAP) of the run")

@@ -47,7 +47,7 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
                            topics=args.bag_topics, with_map=stage.map_pub is not None, prog=prog,
-                           lossless=stage.speedup <= 0)
+                           lossless=stage.pacer.speedup <= 0)
     stage.add_step_listener(recorder.record_step)
     try:
         yield recorder

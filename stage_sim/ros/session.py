@@ -2,8 +2,8 @@
 
 One process and one executor spare the launch machinery and, with ``speedup <= 0``, allow *lockstep*: step
 the world, then spin until every wanderer has answered that step's scan with a command the simulator has
-received (or a short wall timeout passes), so a seed gives the same run every time. With ``speedup > 0`` a
-steady wall timer paces the steps at ``interval_sim / speedup``, as the simulator's own would. Either way
+received (or a short wall timeout passes), so a seed gives the same run every time. With ``speedup > 0`` the
+simulator paces its own steps (:class:`~stage_sim.runs.pacing.Pacer`, as every entry point). Either way
 :class:`~stage_sim.runs.stats.RunStats` samples the ground truth after every step and gives the JSON
 summaries printed at exit.
 """
@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from stage_sim.bags.errors import BagError
+from stage_sim.cli.arguments import add_duration_argument, add_seed_argument, add_speedup_argument
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.recording import add_record_arguments, recording
@@ -39,10 +40,12 @@ CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subsc
 
 
 class WanderSession:
-    """A simulator and a wanderer per robot (namespaced like the simulator's topics), in one executor."""
+    """A simulator and a wanderer per robot (namespaced like the simulator's topics), in one executor, until
+    the world's ``quit_time`` or ``duration`` sim seconds, whichever comes first. ``speedup`` None: the world's."""
 
-    def __init__(self, world: str, speedup: float, seed: int | None, context: Context | None = None) -> None:
-        self.stage = StageRos(world, speedup=speedup, seed=seed, autostep=False, context=context)
+    def __init__(self, world: str, speedup: float | None, seed: int | None, duration: float | None = None,
+                 context: Context | None = None) -> None:
+        self.stage = StageRos(world, speedup=speedup, seed=seed, autostep=False, duration=duration, context=context)
         sim = self.stage.sim
         self.wanderers = []
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
@@ -60,16 +63,16 @@ class WanderSession:
         self.stats = RunStats(sim)
         self.stage.add_step_listener(self.stats.update)
 
-    def run(self, duration: float | None = None, stop: threading.Event | None = None) -> None:
-        """Step until ``duration`` sim seconds, the world's quit_time, or ``stop`` is set (Ctrl-C)."""
+    def run(self, stop: threading.Event | None = None) -> None:
+        """Step until the run's end or until ``stop`` is set (Ctrl-C)."""
         stop = stop or threading.Event()
         self._connect()
-        stage, sim = self.stage, self.stage.sim
-        lockstep = stage.speedup <= 0
+        stage = self.stage
+        lockstep = stage.pacer.speedup <= 0
         if not lockstep:
             stage.start_stepping()
-        while not stage.finished and not stop.is_set() and (duration is None or sim.sim_time < duration - 1e-9):
-            if lockstep and not stage.paused:
+        while not stage.finished and not stop.is_set():
+            if lockstep and not stage.pacer.paused:
                 stage.step_once()
                 self._await_answers()
             else:
@@ -111,10 +114,9 @@ def parse_args(argv: list[str], prog: str, default_world: str, description: str)
     parser = argparse.ArgumentParser(prog=prog, description=description)
     parser.add_argument("world", nargs="?", default=default_world,
                         help=f"a .world file or a bundled world's name (default {default_world})")
-    parser.add_argument("--speedup", type=float, default=1.0,
-                        help="sim seconds per wall second (default 1); <= 0: lockstep, as fast as possible")
-    parser.add_argument("--duration", type=float, default=None, help="sim seconds to run (default: until Ctrl-C)")
-    parser.add_argument("--seed", type=int, default=None, help="seed of the simulator and the wanderers")
+    add_speedup_argument(parser)
+    add_duration_argument(parser)
+    add_seed_argument(parser)
     add_record_arguments(parser)
     add_bag_arguments(parser)
     add_view_options(parser)
@@ -130,10 +132,10 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     session = None
     try:
         with stop_requests() as stop:
-            session = WanderSession(args.world, args.speedup, args.seed)
+            session = WanderSession(args.world, args.speedup, args.seed, args.duration)
             with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog) as recorder,
                   viewing(session.stage, args)):
-                session.run(args.duration, stop)
+                session.run(stop)
             for summary in session.summaries():
                 print(json.dumps(summary), flush=True)
         return 0 if recorder is None or recorder.summary.complete else 1

@@ -3,10 +3,11 @@
 Per robot it subscribes ``cmd_vel`` and publishes ``odom``, ``base_pose_ground_truth``, ``base_scan[_k]``
 and ``stall``; for the world it publishes ``/clock`` (one per step, never 0), ``/tf`` (odom →
 base_footprint every step), ``/tf_static`` (one latched message with every fixed frame) and, on request,
-``/map``; it serves ``reset_positions``. Every stamp is sim time. Steps run on a steady wall timer at
-``interval_sim / speedup`` (``speedup <= 0``: as fast as possible, steps back to back for up to
-FAST_BATCH_S of wall time per timer callback, then callbacks are serviced), never on the clock the node
-publishes.
+``/map``; it serves ``reset_positions``. Every stamp is sim time. A steady wall timer wakes the node every
+``interval_sim / speedup`` (``speedup <= 0``: at every executor round), never the clock the node publishes;
+the run's :class:`~stage_sim.runs.pacing.Pacer` then decides which steps are due, as it does for every
+entry point (as fast as possible: steps back to back for FAST_BATCH_S of wall time, then callbacks are
+serviced).
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from time import perf_counter
 
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
@@ -37,7 +37,7 @@ from stage_sim.bags.names import RobotNames, robot_names
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
 from stage_sim.ros.rival_publishers import RivalPublishers
-from stage_sim.sensing.kernels import threads_for_run
+from stage_sim.runs.pacing import WATCHDOG_S, Pacer, run_end, run_speedup, threads_for_run
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world
 
@@ -56,9 +56,6 @@ TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 # Every request is a caller waiting for its answer: the default services queue (the last 10) drops requests
 # whenever the executor lags (numba loading on its thread, a command flood), and those callers hang forever.
-# Wall seconds of back-to-back steps per timer callback with speedup <= 0: one executor round costs about as
-# much as a step of a small world, and commands, resets and parameters still get in hundreds of times a second.
-FAST_BATCH_S = 0.002
 EVERY_REQUEST = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 
 
@@ -79,27 +76,28 @@ class StageRos(Node):
     def __init__(
         self, world: str | Path | None = None, *, speedup: float | None = None, seed: int | None = None,
         use_model_names: bool | None = None, node_name: str = "stageros", autostep: bool = True,
-        kernels: str | None = None, threads: int | None = None, **kwargs,
+        kernels: str | None = None, threads: int | None = None, duration: float | None = None, **kwargs,
     ) -> None:
         """Load the world and advertise everything; ``autostep=False`` leaves stepping to the caller
         (:meth:`step_once`), for tests and programs that drive the simulation themselves. ``threads``
-        defaults to 1 in real time and to all cores with ``speedup <= 0``."""
+        defaults to 1 in real time and to all cores with ``speedup <= 0``. The run ends at the world's
+        ``quit_time`` or after ``duration`` sim seconds, whichever comes first."""
         super().__init__(node_name, **kwargs)
         world_param = self.declare_parameter("world_file", str(world) if world is not None else "").value
         if not world_param:
             raise ValueError("no world given: pass WORLD on the command line or set the 'world_file' parameter")
         description = load_world(world_param)
         self.world_path = description.path
-        speedup_default = description.settings.speedup if speedup is None else speedup
-        self.speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
+        speedup_default = run_speedup(speedup, description.settings.speedup)
+        speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
         seed_value = int(self.declare_parameter("seed", -1 if seed is None else seed).value)
-        watchdog = float(self.declare_parameter("base_watchdog_timeout", 0.2).value)
+        watchdog = float(self.declare_parameter("base_watchdog_timeout", WATCHDOG_S).value)
         model_names = bool(self.declare_parameter("use_model_names", bool(use_model_names)).value)
         self.publish_map = bool(self.declare_parameter("publish_map", False).value)
         stamped = bool(self.declare_parameter("use_stamped_velocity", False).value)
 
         self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog,
-                              kernels=kernels, threads=threads_for_run(threads, self.speedup))
+                              kernels=kernels, threads=threads_for_run(threads, speedup))
         for warning in self.sim.warnings:
             self.get_logger().warning(str(warning))
         robots = self.sim.robots
@@ -109,16 +107,17 @@ class StageRos(Node):
         self._create_interfaces(stamped)
         self._last_warning = [-math.inf] * len(robots)
         self.quit_time = description.settings.quit_time
+        self.pacer = Pacer(self.sim.interval, speedup, lambda: self.sim.sim_time, run_end(self.quit_time, duration))
         self.finished = False
         self._step_listeners: list[Callable[[], None]] = []
-        self.paused = False
         self.autostep = autostep
         self._timer = self._step_timer(autostep)
+        self._catch_up = self.create_guard_condition(self._step_due)
         self._publish_static()
         self.rivals = RivalPublishers(self, ["/clock"], [t for n in self.names for t in (n.odom, *n.scans[:1])])
         self.get_logger().info(
             f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
-            f"speedup {self.speedup:g}" + (" (as fast as possible)" if self.speedup <= 0 else ""))
+            f"speedup {speedup:g}" + (" (as fast as possible)" if speedup <= 0 else ""))
 
     # -- set-up --------------------------------------------------------------------------------------------
 
@@ -163,17 +162,16 @@ class StageRos(Node):
         super().destroy_node()
 
     def _step_timer(self, start: bool) -> Timer:
-        """The steady wall timer that steps the world every ``interval_sim / speedup`` (0: back to back)."""
-        period = self.sim.interval / self.speedup if self.speedup > 0 else 0.0
-        callback = self.step_once if self.speedup > 0 else self._step_batch
-        return self.create_timer(period, callback, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
+        """The steady wall timer that wakes the node every step period (0: at every executor round)."""
+        return self.create_timer(
+            self.pacer.period, self._step_due, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
 
-    def _step_batch(self) -> None:
-        """Steps back to back for FAST_BATCH_S of wall time (at least one), as fast as possible."""
-        until = perf_counter() + FAST_BATCH_S
-        self.step_once()
-        while perf_counter() < until and not (self.finished or self.paused):
+    def _step_due(self) -> None:
+        """The steps the pacer says are due now; a node woken late comes back after the callbacks waiting."""
+        for _ in self.pacer.steps():
             self.step_once()
+        if self.pacer.behind():
+            self._catch_up.trigger()
 
     def _robot_publisher(self, msg_type: type, topic: str) -> Publisher:
         return self.create_publisher(msg_type, topic, RELIABLE_10, event_callbacks=NO_PUB_EVENTS)
@@ -218,11 +216,11 @@ class StageRos(Node):
     def start_stepping(self) -> None:
         """Step on the node's own timer from now on (for callers that built it with ``autostep=False``)."""
         self.autostep = True
-        self.set_paused(self.paused)
+        self.set_paused(self.pacer.paused)
 
     def set_paused(self, paused: bool) -> None:
         """Stop or resume stepping (the browser view's pause): sim time and /clock stand still meanwhile."""
-        self.paused = paused
+        self.pacer.set_paused(paused)
         if self.autostep and not self.finished:
             if paused:
                 self._timer.cancel()
@@ -231,22 +229,23 @@ class StageRos(Node):
 
     def set_speedup(self, speedup: float) -> None:
         """Step at a new real-time factor from now on (``<= 0``: as fast as possible)."""
-        self.speedup = speedup
+        self.pacer.set_speedup(speedup)
         self.destroy_timer(self._timer)
-        self._timer = self._step_timer(self.autostep and not self.paused and not self.finished)
+        self._timer = self._step_timer(self.autostep and not self.pacer.paused and not self.finished)
 
     def step_once(self) -> None:
         """One simulation step and everything it publishes (none while paused)."""
-        if self.finished or self.paused:
+        if self.finished or self.pacer.paused:
             return
         self.sim.step()
         self._publish_step()
         for listener in self._step_listeners:
             listener()
-        if self.quit_time > 0 and self.sim.sim_time >= self.quit_time:
+        if self.pacer.finished():
             self.finished = True
             self._timer.cancel()
-            self.get_logger().info(f"quit_time {self.quit_time:g} s reached")
+            reason = "quit_time" if self.pacer.end == self.quit_time else "duration"
+            self.get_logger().info(f"{reason} {self.pacer.end:g} s reached")
 
     def _publish_step(self) -> None:
         sim = self.sim

@@ -22,12 +22,12 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
 from stage_sim.bags.errors import BagError
+from stage_sim.cli.arguments import add_kernel_arguments, add_seed_argument, add_speedup_argument
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.core_log import core_log_on
 from stage_sim.ros.recording import add_record_arguments, recording
 from stage_sim.ros.view import add_view_options, viewing
 from stage_sim.runs.interrupts import stop_requests
-from stage_sim.sensing.kernels import add_kernel_arguments
 from stage_sim.worldfile.bundled import bundled_worlds
 from stage_sim.worldfile.errors import WorldError
 
@@ -40,10 +40,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     add_view_options(parser)
     parser.add_argument("-u", action="store_true", dest="use_model_names",
                         help="name robots' topics and frames after their models instead of robot_<i>")
-    parser.add_argument("--speedup", type=float, default=None,
-                        help="sim seconds per wall second (world's 'speedup' if absent; <= 0: as fast as possible)")
-    parser.add_argument("--seed", type=int, default=None, help="seed for drawn odometry errors and sensor noise")
-    add_kernel_arguments(parser, threads_default="1, all cores with --speedup 0")
+    add_speedup_argument(parser)
+    add_seed_argument(parser)
+    add_kernel_arguments(parser)
     add_record_arguments(parser)
     add_bag_arguments(parser)
     parser.add_argument("world", nargs="?", default=None,

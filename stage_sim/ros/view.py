@@ -39,14 +39,7 @@ class RosControls:
 
     def __init__(self, stage: StageRos) -> None:
         self.stage = stage
-
-    @property
-    def paused(self) -> bool:
-        return self.stage.paused
-
-    @property
-    def speedup(self) -> float:
-        return self.stage.speedup
+        self.pacer = stage.pacer
 
     def drive(self, robot: int, vx: float, vy: float, va: float) -> None:
         twist = Twist()

@@ -10,12 +10,10 @@ messages. ``benchmarks/wander_sweep.py --core`` runs many seeds of it.
 from __future__ import annotations
 
 from stage_sim.runs.driver import WanderDriver
+from stage_sim.runs.pacing import END_TOLERANCE_S, WATCHDOG_S, run_end
 from stage_sim.runs.stats import RunStats
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.description import WorldDescription
-
-#: The command watchdog stageros sets (``base_watchdog_timeout``), in sim seconds.
-WATCHDOG_S = 0.2
 
 
 def wander_summaries(description: WorldDescription, seed: int | None, seconds: float) -> list[dict]:
@@ -23,10 +21,8 @@ def wander_summaries(description: WorldDescription, seed: int | None, seconds: f
     robot; one JSON-ready summary per robot, as the launch scripts print them."""
     sim = Simulation(description, seed=seed, watchdog_timeout=WATCHDOG_S)
     driver, stats = WanderDriver(sim, seed), RunStats(sim)
-    end = seconds
-    if description.settings.quit_time > 0:
-        end = min(end, description.settings.quit_time)
-    while sim.sim_time < end - 1e-9:
+    end = run_end(description.settings.quit_time, seconds)
+    while sim.sim_time < end - END_TOLERANCE_S:
         sim.step()
         stats.update()
         driver.decide()

@@ -19,14 +19,15 @@ from stage_sim.view.scene import Scene, robot_names
 from stage_sim.view.server import ViewServer, ViewSettings
 
 if TYPE_CHECKING:
+    from stage_sim.runs.pacing import Pacer
     from stage_sim.sim.simulation import Simulation
 
 
 class Controls(Protocol):
     """What a page may do, as the host of the simulation does it (called between steps only)."""
 
-    paused: bool
-    speedup: float
+    pacer: Pacer
+    """The run's schedule: whether it is paused and at what speedup (changed only through the methods below)."""
 
     def drive(self, robot: int, vx: float, vy: float, va: float) -> None:
         """A velocity command, exactly as one from ``cmd_vel``."""
@@ -80,7 +81,8 @@ class LiveView:
             return
         now = time.monotonic()
         if self.sampler.due(now):
-            frame = self.sampler.take(now, self.controls.paused, self.controls.speedup, force=self._changed)
+            pacer = self.controls.pacer
+            frame = self.sampler.take(now, pacer.paused, pacer.speedup, force=self._changed)
             self._changed = False
             if frame is not None:
                 self.server.publish(frame)

@@ -1,17 +1,20 @@
 """A paced, pausable step loop for a core-only simulation with a view (``stage_sim view``, tests, benchmarks).
 
-It paces steps as ``stageros``' steady timer does (one step per ``interval_sim / speedup`` wall seconds,
-``speedup <= 0`` as fast as possible) and implements the view's :class:`~stage_sim.view.live.Controls` with
-the calls ``stageros`` makes: :meth:`Simulation.set_velocity` for a command (the simulation's watchdog still
-stops a robot nobody commands) and :meth:`Simulation.reset_positions` between steps.
+It steps on the schedule every entry point shares (:class:`~stage_sim.runs.pacing.Pacer`: real time ×
+``speedup``, ``speedup <= 0`` as fast as possible, the lag cap, the run's end) and implements the view's
+:class:`~stage_sim.view.live.Controls` with the calls ``stageros`` makes: :meth:`Simulation.set_velocity` for
+a command (the simulation's watchdog still stops a robot nobody commands) and
+:meth:`Simulation.reset_positions` between steps.
 """
 
 from __future__ import annotations
 
+import math
 import threading
-import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
+
+from stage_sim.runs.pacing import Pacer
 
 if TYPE_CHECKING:
     from stage_sim.sim.simulation import Simulation
@@ -19,19 +22,17 @@ if TYPE_CHECKING:
 
 IDLE_S = 1.0 / 60.0
 """Longest wait between two services of the view while paused or waiting for the next step."""
-MAX_LAG_S = 1.0
-"""A loop further behind its schedule than this (a stalled machine) starts afresh rather than catch up."""
 
 
 class PacedLoop:
-    """Steps ``sim`` in real time × ``speedup``; ``before_step`` (a controller) runs before every step."""
+    """Steps ``sim`` in real time × ``speedup`` until sim time ``end``; ``before_step`` (a controller) runs
+    before every step."""
 
-    def __init__(self, sim: Simulation, speedup: float, before_step: Callable[[], None] | None = None) -> None:
+    def __init__(self, sim: Simulation, speedup: float, before_step: Callable[[], None] | None = None,
+                 end: float = math.inf) -> None:
         self.sim = sim
-        self.speedup = speedup
-        self.paused = False
+        self.pacer = Pacer(sim.interval, speedup, lambda: sim.sim_time, end)
         self.before_step = before_step
-        self.steps = 0
 
     def drive(self, robot: int, vx: float, vy: float, va: float) -> None:
         self.sim.set_velocity(robot, vx, vy, va)
@@ -40,31 +41,19 @@ class PacedLoop:
         self.sim.reset_positions()
 
     def set_paused(self, paused: bool) -> None:
-        self.paused = paused
+        self.pacer.set_paused(paused)
 
     def set_speedup(self, speedup: float) -> None:
-        self.speedup = speedup
+        self.pacer.set_speedup(speedup)
 
-    def run(self, stop: threading.Event, view: LiveView | None = None, duration: float | None = None) -> None:
-        """Step until ``stop`` is set or ``duration`` sim seconds have passed, servicing ``view`` in between."""
-        sim = self.sim
-        due = time.monotonic()
-        while not stop.is_set() and (duration is None or sim.sim_time < duration - 1e-9):
+    def run(self, stop: threading.Event, view: LiveView | None = None) -> None:
+        """Step until ``stop`` is set or the run's end, servicing ``view`` in between."""
+        pacer = self.pacer
+        while not (stop.is_set() or pacer.finished()):
             if view is not None:
                 view.service()
-            now = time.monotonic()
-            if self.paused:
-                stop.wait(IDLE_S)
-                due = now
-                continue
-            if self.speedup > 0:
-                if due > now:
-                    stop.wait(min(due - now, IDLE_S))
-                    continue
-                due = max(due, now - MAX_LAG_S) + sim.interval / self.speedup
-            else:
-                due = now
-            if self.before_step is not None:
-                self.before_step()
-            sim.step()
-            self.steps += 1
+            for _ in pacer.steps():
+                if self.before_step is not None:
+                    self.before_step()
+                self.sim.step()
+            stop.wait(min(pacer.wait_s(), IDLE_S))

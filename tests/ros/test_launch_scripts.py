@@ -85,6 +85,19 @@ def test_ctrl_c_still_prints_the_summaries(tmp_path: Path) -> None:
     assert summary["sim_seconds"] > 1.0 and summary["stall_events"] == 0
 
 
+def test_a_session_ends_at_the_worlds_quit_time_and_runs_at_the_worlds_speedup(tmp_path: Path) -> None:
+    world = tmp_path / "short.world"
+    world.write_text("quit_time 3\nspeedup 0\nresolution 0.02\nposition( pose [0 0 0 0] )\n")
+    result = run_script("reactive.py", str(world), "--seed", "1", cwd=tmp_path, timeout=120)
+    assert result.returncode == 0, result.stderr
+    (summary,) = summaries(result.stdout)
+    assert summary["sim_seconds"] == pytest.approx(3.0)
+    assert "(as fast as possible)" in result.stderr  # the world's speedup 0, not a default of the session's own
+    shorter = run_script("reactive.py", str(world), "--duration", "1", "--seed", "1", cwd=tmp_path, timeout=120)
+    assert shorter.returncode == 0, shorter.stderr
+    assert summaries(shorter.stdout)[0]["sim_seconds"] == pytest.approx(1.0)
+
+
 def test_a_broken_world_exits_2_naming_it(tmp_path: Path) -> None:
     broken = tmp_path / "broken.world"
     broken.write_text("resolution 0.02\nposition( pose [1 2 0 ] \n")

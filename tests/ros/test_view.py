@@ -71,7 +71,7 @@ def test_pause_stops_the_clock_and_speed_changes_the_pace(viewed) -> None:
     sim0, wall0 = stage.sim.sim_time, time.monotonic()
     time.sleep(2.0)
     rate = (stage.sim.sim_time - sim0) / (time.monotonic() - wall0)
-    assert stage.speedup == 4.0
+    assert stage.pacer.speedup == 4.0
     assert rate == pytest.approx(4.0, rel=0.2)
 
 

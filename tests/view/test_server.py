@@ -146,7 +146,7 @@ def test_a_read_only_view_shows_but_ignores_commands() -> None:
 
         assert asyncio.run(try_to_pause())["readonly"] is True
         time.sleep(0.2)
-        assert not running.loop.paused
+        assert not running.loop.pacer.paused
         assert running.view.applied == 0
         assert tuple(running.sim.true_poses[0][:2]) == pytest.approx((11.1, 9.2))
     finally:
