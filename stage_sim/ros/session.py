@@ -2,7 +2,9 @@
 
 One process and one executor spare the launch machinery and, with ``speedup <= 0``, allow *lockstep*: step
 the world, then spin until every wanderer has answered that step's scan with a command the simulator has
-received (or a short wall timeout passes), so a seed gives the same run every time. With ``speedup > 0`` the
+received, however long that takes (a busy or frozen machine only slows the run down), so a seed gives the
+same run every time; a late answer is reported once, and a controller that has gone ends the run with an
+error instead of a silent step without it. With ``speedup > 0`` the
 simulator paces its own steps (:class:`~stage_sim.runs.pacing.Pacer`, as every entry point). Either way
 :class:`~stage_sim.runs.stats.RunStats` samples the ground truth after every step and gives the JSON
 summaries printed at exit.
@@ -35,7 +37,11 @@ from stage_sim.runs.interrupts import stop_requests
 from stage_sim.runs.stats import RunStats
 from stage_sim.worldfile.errors import WorldError
 
-LOCKSTEP_TIMEOUT_S = 0.5  # wall seconds to wait for the wanderers' answers before stepping anyway
+LATE_ANSWER_S = 5.0  # wall seconds of waiting for a lockstep answer before saying which robots are late
+
+
+class ControllerGone(RuntimeError):
+    """A lockstep session waits for a controller that no longer publishes its robot's commands."""
 CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subscriptions to match
 
 
@@ -57,6 +63,7 @@ class WanderSession:
             self.wanderers.append(Wander(
                 f"wander_{index}", namespace=prefix.rstrip("/") or None, context=context, cli_args=remap,
                 parameter_overrides=overrides))
+        self.controller_names = [w.get_name() for w in self.wanderers]  # kept for messages after a node has gone
         self.executor = SingleThreadedExecutor(context=context)
         for node in (self.stage, *self.wanderers):
             self.executor.add_node(node)
@@ -74,7 +81,7 @@ class WanderSession:
         while not stage.finished and not stop.is_set():
             if lockstep and not stage.pacer.paused:
                 stage.step_once()
-                self._await_answers()
+                self._await_answers(stop)
             else:
                 self.executor.spin_once(timeout_sec=0.1)
 
@@ -100,13 +107,31 @@ class WanderSession:
         ):
             self.executor.spin_once(timeout_sec=0.01)
 
-    def _await_answers(self) -> None:
-        """Lockstep: spin until each robot that got a scan this step has had its command accepted."""
-        sim = self.stage.sim
+    def _await_answers(self, stop: threading.Event) -> None:
+        """Lockstep: spin until each robot that got a scan this step has had its command accepted, or ``stop``.
+
+        Never steps on without an answer: says once which robots are late after LATE_ANSWER_S, and raises
+        ControllerGone when a late robot's ``cmd_vel`` has no publisher left."""
+        stage, sim = self.stage, self.stage.sim
         waiting = [i for i in range(len(self.wanderers)) if any(s.stamp == sim.sim_time for s in sim.scans[i])]
-        deadline = time.monotonic() + LOCKSTEP_TIMEOUT_S
-        while any(sim.last_command_us[i] != sim.sim_time_us for i in waiting) and time.monotonic() < deadline:
+        started, warned = time.monotonic(), False
+        while not stop.is_set():
+            late = [i for i in waiting if sim.last_command_us[i] != sim.sim_time_us]
+            if not late:
+                return
             self.executor.spin_once(timeout_sec=0.01)
+            if time.monotonic() - started < LATE_ANSWER_S:
+                continue
+            gone = [i for i in late if stage.count_publishers(stage.names[i].cmd_vel) == 0]
+            if gone:
+                raise ControllerGone(f"lockstep: nothing publishes {', '.join(stage.names[i].cmd_vel for i in gone)} "
+                                     f"any more (controller {', '.join(self.controller_names[i] for i in gone)})")
+            if not warned:
+                warned = True
+                stage.get_logger().warning(
+                    f"lockstep: the step to sim time {sim.sim_time:g} s has waited {LATE_ANSWER_S:g} s for the "
+                    f"commands of {', '.join(stage.names[i].cmd_vel for i in late)} (nodes "
+                    f"{', '.join(self.controller_names[i] for i in late)}); still waiting")
 
 
 def parse_args(argv: list[str], prog: str, default_world: str, description: str) -> argparse.Namespace:
@@ -142,6 +167,9 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     except (WorldError, FileNotFoundError, ValueError, BagError) as error:
         print(f"{prog}: {error}", file=sys.stderr)
         return 2
+    except ControllerGone as error:
+        print(f"{prog}: {error}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         return 0
     finally:
