@@ -5,6 +5,7 @@ Dependencies point one way only, top to bottom (enforced by import-linter, ``.im
     cli | ros                                   entry points; only ros imports rclpy
     envs                                        Gymnasium / PettingZoo environments
     runs | rendering | view | bags              uses of a running simulation
+    interface                                   stageros' topics, names, frames, QoS, field values (no rclpy)
     wander                                      the reactive controller (never imports sim)
     sim                                         Simulation: robots, kinematics, odometry, collision
     sensing                                     ray casting on the grid, Stage's walk

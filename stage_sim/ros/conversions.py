@@ -1,6 +1,6 @@
 """Pure conversions from simulation state to ROS messages: no node, no publishing, easy to test.
 
-The values come from :mod:`stage_sim.bags.fields`, which the ROS-free bag writer uses too.
+The values come from :mod:`stage_sim.interface.fields`, which the ROS-free bag writer uses too.
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
-from stage_sim.bags import fields
+from stage_sim.interface import fields
+from stage_sim.interface.frames import Edge
 from stage_sim.sim.rangers import Scan
 from stage_sim.sim.robots import RangerSpec
 from stage_sim.worldfile.occupancy import OccupancyGrid
@@ -95,7 +96,7 @@ def transform(parent: str, child: str, x: float, y: float, z: float, yaw: float,
     return t
 
 
-def edge_transform(edge: fields.Edge, time: Time) -> TransformStamped:
+def edge_transform(edge: Edge, time: Time) -> TransformStamped:
     """A fixed TF edge (/tf_static) at ``time``."""
     return transform(edge.parent, edge.child, edge.x, edge.y, edge.z, edge.yaw, time)
 
