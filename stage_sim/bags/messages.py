@@ -12,7 +12,7 @@ filler per topic, as :mod:`stage_sim.ros.topic_messages` does for rclpy.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -22,7 +22,7 @@ from rosbags.typesys import Stores, get_typestore
 from stage_sim.bags.topics import Topic as RecordedTopic
 from stage_sim.interface import fields, frames, topics
 from stage_sim.interface.names import RobotNames
-from stage_sim.interface.topics import Endpoint, Timing, Topic
+from stage_sim.interface.topics import Endpoint, Fill, Timing, Topic, TopicMessage
 from stage_sim.sim.simulation import Simulation
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -91,19 +91,6 @@ def _odometry(frame: str, child: str) -> object:
         twist=TwistWithCovariance(
             twist=Twist(linear=Vector3(x=0.0, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.0)),
             covariance=_NO_COVARIANCE))
-
-
-Build = Callable[[Endpoint, Simulation, Sequence[RobotNames]], Any]
-Fill = Callable[[Any, Any, Endpoint, object], Any]
-"""(built message, the topic's values this step, endpoint, stamp) → the message to write, None for none."""
-
-
-@dataclass(frozen=True)
-class TopicMessage:
-    """How one topic's message is built once and filled per publication."""
-
-    build: Build
-    fill: Fill
 
 
 def _nothing(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> None:

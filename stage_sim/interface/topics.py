@@ -73,6 +73,21 @@ class Endpoint:
     ranger: int | None = None
 
 
+Build = Callable[[Endpoint, "Simulation", Sequence[RobotNames]], Any]
+"""(endpoint, simulation, robot names) → the endpoint's message with everything that never changes."""
+Fill = Callable[[Any, Any, Endpoint, Any], Any]
+"""(built message, the topic's values this step, endpoint, stamp) → the message to send, None for none."""
+
+
+@dataclass(frozen=True)
+class TopicMessage:
+    """How one writer of messages (rclpy in :mod:`stage_sim.ros`, rosbags in :mod:`stage_sim.bags`) makes a
+    topic's message: built once per endpoint, refilled for every publication."""
+
+    build: Build
+    fill: Fill
+
+
 def endpoints(topic: Topic, names: Sequence[RobotNames]) -> list[Endpoint]:
     """Every instance of ``topic`` in a world whose robots are called ``names``, robot by robot."""
     if topic.scope is Scope.WORLD:

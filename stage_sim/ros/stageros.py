@@ -28,12 +28,12 @@ from std_srvs.srv import Empty
 
 from stage_sim.interface import qos, topics
 from stage_sim.interface.names import RobotNames, robot_names
-from stage_sim.interface.topics import Endpoint, Scope, Timing, Topic
+from stage_sim.interface.topics import Endpoint, Fill, Scope, Timing, Topic
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
 from stage_sim.ros.qos import qos_profile
 from stage_sim.ros.rival_publishers import RivalPublishers
-from stage_sim.ros.topic_messages import TOPIC_MESSAGES, Fill, message_class
+from stage_sim.ros.topic_messages import TOPIC_MESSAGES, message_class
 from stage_sim.sensing.kernels import threads_for_run
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.bundled import find_world

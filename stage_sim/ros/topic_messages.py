@@ -8,8 +8,7 @@ publishing serialises, so reuse is safe, and nothing is allocated per step.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import Any
 
 from builtin_interfaces.msg import Time
@@ -22,21 +21,9 @@ from tf2_msgs.msg import TFMessage
 from stage_sim.interface import frames, topics
 from stage_sim.interface.fields import LatestScans
 from stage_sim.interface.names import RobotNames
-from stage_sim.interface.topics import Endpoint, Topic
+from stage_sim.interface.topics import Endpoint, Topic, TopicMessage
 from stage_sim.ros import conversions
 from stage_sim.sim.simulation import Simulation
-
-Build = Callable[[Endpoint, Simulation, Sequence[RobotNames]], Any]
-Fill = Callable[[Any, Any, Endpoint, Time], Any]
-"""(built message, the topic's values this step, endpoint, stamp) → the message to publish, None for none."""
-
-
-@dataclass(frozen=True)
-class TopicMessage:
-    """How one topic's message is built and filled."""
-
-    build: Build
-    fill: Fill
 
 
 def message_class(topic: Topic) -> type:

@@ -75,6 +75,7 @@ def test_values_are_the_simulation_state_of_the_step(two_robots) -> None:
     poses, velocities = topics.ODOM.values(sim, names)
     assert poses is sim.odometry_poses and velocities is sim.velocities
     truth, true_velocities = topics.GROUND_TRUTH.values(sim, names)
+    assert truth is sim.true_poses
     np.testing.assert_array_equal(true_velocities, fields.ground_truth_velocities(sim))
     assert topics.CLOCK.values(sim, names) == sim.sim_time_us
     scans = topics.SCAN.values(sim, names)
