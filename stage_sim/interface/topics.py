@@ -35,6 +35,7 @@ class Timing(Enum):
 
     STEP = "every step"
     MEASURED = "in the steps its ranger measured in"
+    """Its values answer ``measured(robot, ranger)`` with this step's measurement or None."""
     START = "once at start, latched"
 
 
@@ -47,6 +48,8 @@ class Topic:
     """One topic of stageros' interface."""
 
     name: str
+    """``/clock`` (world: absolute), ``odom`` (per robot: under its prefix), ``base_scan`` (per ranger:
+    ``base_scan_<k>`` on a robot with several)."""
     msgtype: str
     qos: Qos
     scope: Scope
