@@ -48,7 +48,7 @@ def main(argv: list[str]) -> int:
         with sigterm_interrupts():
             stage = StageRos(args.world, speedup=args.speedup, seed=args.seed, duration=args.duration)
             nodes.append(stage)
-            namespace = stage.names[0].cmd_vel[: -len("cmd_vel")].rstrip("/") if stage.names else ""
+            namespace = stage.names[0].label if stage.names else ""
             teleop = TeleopTwistKeyboard(namespace=namespace or None)
             nodes.append(teleop)
             for node in nodes:

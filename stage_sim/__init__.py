@@ -7,6 +7,7 @@ Dependencies point one way only, top to bottom (enforced by import-linter, ``.im
     envs                                        Gymnasium / PettingZoo environments
     rendering | view | bags                     uses of a running simulation
     runs                                        how a run is paced, driven, measured and stopped
+    interface                                   stageros' topics, names, frames, QoS, field values (no rclpy)
     wander                                      the reactive controller (never imports sim)
     sim                                         Simulation: robots, kinematics, odometry, collision
     sensing                                     ray casting on the grid, Stage's walk

@@ -2,6 +2,6 @@
 
 ``BagRecorder`` (recorder.py) records a simulation step by step from a writer thread; the container
 (container.py, the ``mcap`` library) and the messages (messages.py, ``rosbags``' classes and CDR) follow what
-``ros2 bag record -s mcap`` writes; names.py and fields.py describe stageros' names and field values for both
-the ROS layer and the bags; recover.py rescues a file cut short.
+``ros2 bag record -s mcap`` writes; topics, names and field values come from :mod:`stage_sim.interface`, as
+the ROS layer's do; recover.py rescues a file cut short.
 """

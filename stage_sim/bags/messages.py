@@ -5,23 +5,25 @@ generates the ros2msg schema text and RIHS01 type hashes rosbag2 records, and se
 without a Python loop per element (about 10 µs for a 240-beam scan).
 
 The stepping thread only takes a :class:`StepState` (a few array copies); building and serialising the
-messages happens on the bag's writer thread. Field values come from :mod:`stage_sim.bags.fields`, the
-description the ROS layer fills its rclpy messages from.
+messages happens on the bag's writer thread. The topics and their values come from the interface registry
+(:mod:`stage_sim.interface.topics`), the one the ROS layer publishes from; this module holds one message
+filler per topic, as :mod:`stage_sim.ros.topic_messages` does for rclpy.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
-from stage_sim.bags import fields
-from stage_sim.bags.names import RobotNames
-from stage_sim.bags.topics import CLOCK, MAP, TF, TF_STATIC, RobotTopics
+from stage_sim.bags.topics import Topic as RecordedTopic
+from stage_sim.interface import fields, frames, topics
+from stage_sim.interface.names import RobotNames
+from stage_sim.interface.topics import Endpoint, Fill, Timing, Topic, TopicMessage
 from stage_sim.sim.simulation import Simulation
-from stage_sim.worldfile.occupancy import OccupancyGrid
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 _T = TYPESTORE.types
@@ -38,33 +40,29 @@ OccupancyGridMsg, MapMetaData = _T["nav_msgs/msg/OccupancyGrid"], _T["nav_msgs/m
 _NO_COVARIANCE = np.zeros(36, dtype=np.float64)
 
 
+def _owned(value: Any) -> Any:
+    """A topic's values, safe to keep while the simulation steps on (arrays copied, scans snapshotted)."""
+    if isinstance(value, np.ndarray):
+        return value.copy()
+    if isinstance(value, tuple):
+        return tuple(_owned(v) for v in value)
+    if isinstance(value, fields.LatestScans):
+        return value.snapshot()
+    return value
+
+
 @dataclass(frozen=True)
 class StepState:
     """What one step publishes, copied off the simulation so the writer thread can build it later."""
 
     sim_time_us: int
-    odometry: np.ndarray
-    truth: np.ndarray
-    velocities: np.ndarray
-    truth_velocities: np.ndarray
-    stalled: np.ndarray
-    scans: tuple[tuple[int, int, np.ndarray, np.ndarray], ...]
-    """(robot, ranger, ranges, intensities) of every ranger that measured in this step."""
+    values: dict[Topic, Any]
+    """The values of every per-step topic (:attr:`Topic.values`)."""
 
     @classmethod
-    def capture(cls, sim: Simulation) -> StepState:
-        """Copy the state of the step just taken (cheap: small arrays and the fresh scans)."""
-        return cls(
-            sim.sim_time_us, sim.odometry_poses.copy(), sim.true_poses.copy(), sim.velocities.copy(),
-            sim.true_velocities, sim.stalled.copy(),
-            tuple((i, k, *fields.scan_arrays(scan)) for i, robot_scans in enumerate(sim.scans)
-                  for k, scan in enumerate(robot_scans) if fields.is_fresh(scan, sim)),
-        )
-
-    @property
-    def message_count(self) -> int:
-        """Messages this step publishes on every topic: /clock, /tf, odom, truth and stall per robot, scans."""
-        return 2 + 3 * len(self.stalled) + len(self.scans)
+    def capture(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> StepState:
+        """Copy the state of the step just taken (cheap: small arrays and references to the fresh scans)."""
+        return cls(sim.sim_time_us, {topic: _owned(topic.values(sim, names)) for topic in stepped})
 
 
 def _time(sim_time_us: int) -> object:
@@ -77,7 +75,7 @@ def _quaternion(yaw: float) -> object:
     return Quaternion(x=x, y=y, z=z, w=w)
 
 
-def _transform(time: object, edge: fields.Edge) -> object:
+def _transform(time: object, edge: frames.Edge) -> object:
     return TransformStamped(
         header=Header(stamp=time, frame_id=edge.parent), child_frame_id=edge.child,
         transform=Transform(translation=Vector3(x=float(edge.x), y=float(edge.y), z=float(edge.z)),
@@ -95,7 +93,26 @@ def _odometry(frame: str, child: str) -> object:
             covariance=_NO_COVARIANCE))
 
 
-def _fill_odometry(msg: object, time: object, pose: np.ndarray, velocity: np.ndarray) -> object:
+def _nothing(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> None:
+    """For topics whose message is made whole at each publication."""
+
+
+def _fill_clock(msg: None, sim_time_us: int, endpoint: Endpoint, time: object) -> object:
+    return Clock(clock=time)
+
+
+def _build_odometry(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> object:
+    robot = names[endpoint.robot]
+    return _odometry(robot.odom_frame, robot.base_footprint)
+
+
+def _build_ground_truth(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> object:
+    return _odometry(frames.WORLD_FRAME, names[endpoint.robot].base_footprint)
+
+
+def _fill_odometry(msg: Any, values: tuple[np.ndarray, np.ndarray], endpoint: Endpoint, time: object) -> object:
+    poses, velocities = values
+    pose, velocity = poses[endpoint.robot], velocities[endpoint.robot]
     msg.header.stamp = time
     position, orientation = msg.pose.pose.position, msg.pose.pose.orientation
     position.x, position.y = float(pose[0]), float(pose[1])
@@ -105,81 +122,125 @@ def _fill_odometry(msg: object, time: object, pose: np.ndarray, velocity: np.nda
     return msg
 
 
-@dataclass
-class _RobotMessages:
-    """The messages one robot publishes every step, allocated once and refilled (as the node does)."""
+def _build_stall(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> object:
+    return Bool(data=False)
 
-    odom: object
-    truth: object
-    stall: object
-    odom_tf: object
-    scans: list[object]
+
+def _fill_stall(msg: Any, stalled: np.ndarray, endpoint: Endpoint, time: object) -> object:
+    msg.data = bool(stalled[endpoint.robot])
+    return msg
+
+
+def _build_scan(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> object:
+    ranger = sim.robots[endpoint.robot].rangers[endpoint.ranger]
+    return LaserScan(header=Header(stamp=_time(0), frame_id=names[endpoint.robot].laser_frames[endpoint.ranger]),
+                     **asdict(fields.scan_geometry(ranger)),
+                     ranges=np.zeros(0, np.float32), intensities=np.zeros(0, np.float32))
+
+
+def _fill_scan(msg: Any, scans: fields.LatestScans, endpoint: Endpoint, time: object) -> object | None:
+    scan = scans.measured(endpoint.robot, endpoint.ranger)
+    if scan is None:
+        return None
+    msg.header.stamp = time
+    msg.ranges, msg.intensities = fields.scan_arrays(scan)
+    return msg
+
+
+def _build_tf(endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> object:
+    return TFMessage(transforms=[_transform(_time(0), frames.odometry_edge(n)) for n in names])
+
+
+def _fill_tf(msg: Any, odometry_poses: np.ndarray, endpoint: Endpoint, time: object) -> object:
+    for transform_stamped, pose in zip(msg.transforms, odometry_poses, strict=True):
+        transform = transform_stamped.transform
+        transform_stamped.header.stamp = time
+        transform.translation.x, transform.translation.y = float(pose[0]), float(pose[1])
+        _, _, transform.rotation.z, transform.rotation.w = fields.yaw_quaternion(float(pose[2]))
+    return msg
+
+
+def _fill_tf_static(msg: None, edges: list[frames.Edge], endpoint: Endpoint, time: object) -> object:
+    return TFMessage(transforms=[_transform(time, edge) for edge in edges])
+
+
+def _fill_map(msg: None, grid: Any, endpoint: Endpoint, time: object) -> object:
+    origin = Pose(position=Point(x=float(grid.origin[0]), y=float(grid.origin[1]), z=0.0),
+                  orientation=_quaternion(grid.origin[2]))
+    info = MapMetaData(map_load_time=time, resolution=float(grid.resolution), width=grid.width,
+                       height=grid.height, origin=origin)
+    return OccupancyGridMsg(header=Header(stamp=time, frame_id=frames.WORLD_FRAME), info=info,
+                            data=grid.values.astype(np.int8).ravel())
+
+
+TOPIC_MESSAGES: dict[Topic, TopicMessage] = {
+    topics.CLOCK: TopicMessage(_nothing, _fill_clock),
+    topics.ODOM: TopicMessage(_build_odometry, _fill_odometry),
+    topics.GROUND_TRUTH: TopicMessage(_build_ground_truth, _fill_odometry),
+    topics.STALL: TopicMessage(_build_stall, _fill_stall),
+    topics.SCAN: TopicMessage(_build_scan, _fill_scan),
+    topics.TF: TopicMessage(_build_tf, _fill_tf),
+    topics.TF_STATIC: TopicMessage(_nothing, _fill_tf_static),
+    topics.MAP: TopicMessage(_nothing, _fill_map),
+}
+"""The message of every topic stageros publishes (a test holds this to :data:`topics.PUBLISHED`)."""
+
+
+@dataclass
+class _Channel:
+    """One interface topic in the bag: its filler and, per recorded endpoint, the bag topic and built message."""
+
+    topic: Topic
+    fill: Fill
+    outlets: list[tuple[str, Any, Endpoint]]
 
 
 class MessageBuilder:
-    """Turns a simulation's states into (topic, log time ns, CDR bytes) as stageros would publish them."""
+    """Turns a simulation's states into (topic, log time ns, CDR bytes) as stageros would publish them,
+    for the ``recorded`` topics only."""
 
-    def __init__(self, sim: Simulation, names: list[RobotNames], topics: list[RobotTopics]) -> None:
-        self.topics = topics
-        self.edges = fields.static_edges(sim.robots, names)
-        self._out = [
-            _RobotMessages(
-                odom=_odometry(n.odom_frame, n.base_footprint),
-                truth=_odometry(fields.WORLD_FRAME, n.base_footprint),
-                stall=Bool(data=False),
-                odom_tf=_transform(_time(0), fields.Edge(n.odom_frame, n.base_footprint, 0.0, 0.0, 0.0, 0.0)),
-                scans=[LaserScan(header=Header(stamp=_time(0), frame_id=frame), **asdict(fields.scan_geometry(r)),
-                                 ranges=np.zeros(0, np.float32), intensities=np.zeros(0, np.float32))
-                       for r, frame in zip(robot.rangers, n.laser_frames, strict=True)],
-            )
-            for robot, n in zip(sim.robots, names, strict=True)
-        ]
-        self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
+    def __init__(self, sim: Simulation, names: Sequence[RobotNames], recorded: list[RecordedTopic]) -> None:
+        self._names = names
+        self._channels: list[_Channel] = []
+        for topic in topics.PUBLISHED:
+            outlets = [(r.name, TOPIC_MESSAGES[topic].build(r.endpoint, sim, names), r.endpoint)
+                       for r in recorded if r.endpoint.topic is topic]
+            if outlets:
+                self._channels.append(_Channel(topic, TOPIC_MESSAGES[topic].fill, outlets))
+        self.stepped = [c.topic for c in self._channels if c.topic.timing is not Timing.START]
+        """The recorded topics published every step: what :meth:`StepState.capture` takes."""
 
-    def static(self, sim_time_us: int, grid: OccupancyGrid | None) -> Iterator[tuple[str, int, bytes]]:
-        """The latched messages stageros sends once at start: /tf_static, and /map when asked."""
-        time = _time(sim_time_us)
-        log_time = fields.stamp_ns(sim_time_us)
-        tf = TFMessage(transforms=[_transform(time, edge) for edge in self.edges])
-        yield TF_STATIC, log_time, TYPESTORE.serialize_cdr(tf, TFMessage.__msgtype__)
-        if grid is not None:
-            origin = Pose(position=Point(x=float(grid.origin[0]), y=float(grid.origin[1]), z=0.0),
-                          orientation=_quaternion(grid.origin[2]))
-            info = MapMetaData(map_load_time=time, resolution=float(grid.resolution), width=grid.width,
-                               height=grid.height, origin=origin)
-            msg = OccupancyGridMsg(header=Header(stamp=time, frame_id=fields.WORLD_FRAME), info=info,
-                                   data=grid.values.astype(np.int8).ravel())
-            yield MAP, log_time, TYPESTORE.serialize_cdr(msg, OccupancyGridMsg.__msgtype__)
+    def static(self, sim: Simulation) -> Iterator[tuple[str, int, bytes]]:
+        """The latched messages stageros sends once at start: /tf_static, and /map when recorded."""
+        time = _time(sim.sim_time_us)
+        log_time = fields.stamp_ns(sim.sim_time_us)
+        for channel in self._channels:
+            if channel.topic.timing is Timing.START:
+                yield from self._publish(channel, channel.topic.values(sim, self._names), time, log_time)
 
-    def step(self, state: StepState, wanted: set[str]) -> Iterator[tuple[str, int, bytes]]:
-        """Everything one step publishes on the ``wanted`` topics, in stageros' publishing order."""
+    def step(self, state: StepState) -> Iterator[tuple[str, int, bytes]]:
+        """Everything one step publishes on the recorded topics, in stageros' publishing order."""
         time = _time(state.sim_time_us)
         log_time = fields.stamp_ns(state.sim_time_us)
-        serialize = TYPESTORE.serialize_cdr
-        if CLOCK in wanted:
-            yield CLOCK, log_time, serialize(Clock(clock=time), Clock.__msgtype__)
-        scans: dict[int, list[tuple[int, np.ndarray, np.ndarray]]] = {}
-        for robot, ranger, ranges, intensities in state.scans:
-            scans.setdefault(robot, []).append((ranger, ranges, intensities))
-        for i, (out, topics) in enumerate(zip(self._out, self.topics, strict=True)):
-            if topics.odom in wanted:
-                msg = _fill_odometry(out.odom, time, state.odometry[i], state.velocities[i])
-                yield topics.odom, log_time, serialize(msg, Odometry.__msgtype__)
-            if topics.ground_truth in wanted:
-                msg = _fill_odometry(out.truth, time, state.truth[i], state.truth_velocities[i])
-                yield topics.ground_truth, log_time, serialize(msg, Odometry.__msgtype__)
-            if topics.stall in wanted:
-                out.stall.data = bool(state.stalled[i])
-                yield topics.stall, log_time, serialize(out.stall, Bool.__msgtype__)
-            for ranger, ranges, intensities in scans.get(i, ()):
-                if topics.scans[ranger] in wanted:
-                    msg = out.scans[ranger]
-                    msg.header.stamp, msg.ranges, msg.intensities = time, ranges, intensities
-                    yield topics.scans[ranger], log_time, serialize(msg, LaserScan.__msgtype__)
-        if TF in wanted:
-            for out, pose in zip(self._out, state.odometry, strict=True):
-                transform = out.odom_tf.transform
-                out.odom_tf.header.stamp = time
-                transform.translation.x, transform.translation.y = float(pose[0]), float(pose[1])
-                _, _, transform.rotation.z, transform.rotation.w = fields.yaw_quaternion(float(pose[2]))
-            yield TF, log_time, serialize(self._tf, TFMessage.__msgtype__)
+        for channel in self._channels:
+            if channel.topic.timing is not Timing.START:
+                yield from self._publish(channel, state.values[channel.topic], time, log_time)
+
+    def publications(self, state: StepState) -> int:
+        """How many messages :meth:`step` makes of ``state`` (without building them)."""
+        count = 0
+        for channel in self._channels:
+            if channel.topic.timing is Timing.STEP:
+                count += len(channel.outlets)
+            elif channel.topic.timing is Timing.MEASURED:
+                values = state.values[channel.topic]
+                count += sum(values.measured(e.robot, e.ranger) is not None for _, _, e in channel.outlets)
+        return count
+
+    @staticmethod
+    def _publish(channel: _Channel, values: Any, time: object, log_time: int) -> Iterator[tuple[str, int, bytes]]:
+        msgtype = channel.topic.msgtype
+        for name, msg, endpoint in channel.outlets:
+            filled = channel.fill(msg, values, endpoint, time)
+            if filled is not None:
+                yield name, log_time, TYPESTORE.serialize_cdr(filled, msgtype)

@@ -24,8 +24,8 @@ from pathlib import Path
 from stage_sim.bags.container import McapBag
 from stage_sim.bags.errors import BagError
 from stage_sim.bags.messages import TYPESTORE, MessageBuilder, StepState
-from stage_sim.bags.names import RobotNames
-from stage_sim.bags.topics import MAP, robot_topics, select, stageros_topics
+from stage_sim.bags.topics import select, stageros_topics
+from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
 BATCH_STEPS = 64
@@ -79,14 +79,9 @@ class BagRecorder:
         self._sim = sim
         self._prog = prog
         self.lossless = lossless
-        per_robot = robot_topics(names, namespace)
-        self.topics = select(stageros_topics(per_robot, with_map), topics, namespace)
-        self._wanted = {t.name for t in self.topics}
-        self._builder = MessageBuilder(sim, names, per_robot)
-        self._scan_wanted = {(i, k) for i, robot in enumerate(per_robot)
-                             for k, name in enumerate(robot.scans) if name in self._wanted}
-        self._per_step = sum(name in self._wanted for name in ("/clock", "/tf")) + sum(
-            (r.odom in self._wanted) + (r.ground_truth in self._wanted) + (r.stall in self._wanted) for r in per_robot)
+        self._names = names
+        self.topics = select(stageros_topics(names, with_map, namespace), topics, namespace)
+        self._builder = MessageBuilder(sim, names, self.topics)
         self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY)
         self.messages = self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
@@ -94,11 +89,9 @@ class BagRecorder:
         """What was recorded, once :meth:`close` has run."""
         self._crash: BaseException | None = None
         try:
-            grid = sim.static.to_occupancy_grid() if MAP in self._wanted else None
-            for topic, log_time, data in self._builder.static(sim.sim_time_us, grid):
-                if topic in self._wanted:
-                    self._bag.write(topic, log_time, data)
-                    self.messages += 1
+            for topic, log_time, data in self._builder.static(sim):
+                self._bag.write(topic, log_time, data)
+                self.messages += 1
             self._bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             self._bag.abort()
@@ -121,13 +114,13 @@ class BagRecorder:
         writer and a real-time one drop the step."""
         if self.failed:
             return
-        state = StepState.capture(self._sim)
+        state = StepState.capture(self._sim, self._names, self._builder.stepped)
         try:
             self._queue.put_nowait(state)
         except queue.Full:
             if not (self.lossless and self._wait_for_room(state)):
                 self.dropped_steps += 1
-                self.dropped_messages += self._per_step + sum((i, k) in self._scan_wanted for i, k, *_ in state.scans)
+                self.dropped_messages += self._builder.publications(state)
                 return
         if self._queue.qsize() >= self._batch:
             self._wake.set()
@@ -178,7 +171,7 @@ class BagRecorder:
         """One step's messages into the bag; a write error stops the recording, a bug is kept for close()."""
         if self.error is None and self._crash is None:
             try:
-                for topic, log_time, data in self._builder.step(state, self._wanted):
+                for topic, log_time, data in self._builder.step(state):
                     self._bag.write(topic, log_time, data)
                     self.messages += 1
             except OSError as exc:

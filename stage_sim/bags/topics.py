@@ -1,13 +1,14 @@
 """What a bag of a simulation holds: every topic stageros publishes, with its type and offered QoS.
 
-Names are fully qualified as ``ros2 bag record`` stores them (the node namespace before the relative
-per-robot names); the QoS profiles are stageros' own (design: /clock and per-robot topics reliable depth 10,
-/tf depth 100, /tf_static and /map transient-local depth 1), written the way rosbag2 writes a topic's
-``offered_qos_profiles`` so that ``ros2 bag play`` offers them again (late joiners still get /tf_static).
+The list is the interface registry's (:mod:`stage_sim.interface.topics`). Names are fully qualified as
+``ros2 bag record`` stores them (the node namespace before the relative per-robot names); the QoS profiles
+are stageros' own, written the way rosbag2 writes a topic's ``offered_qos_profiles`` so that ``ros2 bag play``
+offers them again (late joiners still get /tf_static).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from io import StringIO
 
@@ -15,22 +16,24 @@ from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, Qo
 from rosbags.rosbag2.metadata import dump_qos_v9
 from ruamel.yaml import YAML
 
-from stage_sim.bags.names import RobotNames
+from stage_sim.interface import qos as plain
+from stage_sim.interface import topics
+from stage_sim.interface.names import RobotNames
+from stage_sim.interface.topics import Endpoint, Scope
 
 # RMW_DURATION_INFINITE, as rosbag2 records an unset deadline, lifespan and lease duration.
 _INFINITE = QosTime(sec=9223372036, nsec=854775807)
+_RELIABILITY = {plain.Reliability.RELIABLE: QosReliability.RELIABLE,
+                plain.Reliability.BEST_EFFORT: QosReliability.BEST_EFFORT}
+_DURABILITY = {plain.Durability.VOLATILE: QosDurability.VOLATILE,
+               plain.Durability.TRANSIENT_LOCAL: QosDurability.TRANSIENT_LOCAL}
+_HISTORY = {plain.History.KEEP_LAST: QosHistory.KEEP_LAST, plain.History.KEEP_ALL: QosHistory.KEEP_ALL}
 
 
-def _reliable(depth: int, durability: QosDurability = QosDurability.VOLATILE) -> Qos:
-    return Qos(QosHistory.KEEP_LAST, depth, QosReliability.RELIABLE, durability, _INFINITE, _INFINITE,
-               QosLiveliness.AUTOMATIC, _INFINITE, False)
-
-
-RELIABLE_10 = _reliable(10)
-TF_QOS = _reliable(100)
-LATCHED = _reliable(1, QosDurability.TRANSIENT_LOCAL)
-
-CLOCK, TF, TF_STATIC, MAP = "/clock", "/tf", "/tf_static", "/map"
+def bag_qos(qos: plain.Qos) -> Qos:
+    """The profile rosbag2 records for a publisher offering ``qos``."""
+    return Qos(_HISTORY[qos.history], qos.depth, _RELIABILITY[qos.reliability], _DURABILITY[qos.durability],
+               _INFINITE, _INFINITE, QosLiveliness.AUTOMATIC, _INFINITE, False)
 
 
 def yaml_text(data: object) -> str:
@@ -44,25 +47,22 @@ def yaml_text(data: object) -> str:
 
 @dataclass(frozen=True)
 class Topic:
-    """One recorded topic."""
+    """One recorded topic: its fully qualified name and the interface endpoint it records."""
 
     name: str
-    msgtype: str
-    qos: Qos
+    endpoint: Endpoint
+
+    @property
+    def msgtype(self) -> str:
+        return self.endpoint.topic.msgtype
+
+    @property
+    def qos(self) -> Qos:
+        return bag_qos(self.endpoint.topic.qos)
 
     def offered_qos_profiles(self) -> str:
         """The channel metadata value rosbag2 writes (metadata version 9: a YAML list of profiles)."""
         return yaml_text(dump_qos_v9([self.qos]))
-
-
-@dataclass(frozen=True)
-class RobotTopics:
-    """The fully qualified topic names of one robot."""
-
-    odom: str
-    ground_truth: str
-    stall: str
-    scans: tuple[str, ...]
 
 
 def qualify(namespace: str, name: str) -> str:
@@ -72,41 +72,24 @@ def qualify(namespace: str, name: str) -> str:
     return f"{namespace.rstrip('/')}/{name}"
 
 
-def robot_topics(names: list[RobotNames], namespace: str = "/") -> list[RobotTopics]:
-    """Each robot's published topics, qualified in ``namespace``."""
-    return [
-        RobotTopics(qualify(namespace, n.odom), qualify(namespace, n.ground_truth), qualify(namespace, n.stall),
-                    tuple(qualify(namespace, s) for s in n.scans))
-        for n in names
-    ]
+def stageros_topics(names: Sequence[RobotNames], with_map: bool, namespace: str = "/") -> list[Topic]:
+    """Every topic stageros publishes, qualified in ``namespace``: world topics first, then robot by robot."""
+    published = topics.published(with_map)
+    world = [e for t in published if t.scope is Scope.WORLD for e in topics.endpoints(t, names)]
+    per_robot = sorted((e for t in published if t.scope is not Scope.WORLD for e in topics.endpoints(t, names)),
+                       key=lambda e: e.robot)
+    return [Topic(qualify(namespace, e.name), e) for e in world + per_robot]
 
 
-def stageros_topics(robots: list[RobotTopics], with_map: bool) -> list[Topic]:
-    """Every topic stageros publishes, world topics first, then robot by robot."""
-    topics = [
-        Topic(CLOCK, "rosgraph_msgs/msg/Clock", RELIABLE_10),
-        Topic(TF, "tf2_msgs/msg/TFMessage", TF_QOS),
-        Topic(TF_STATIC, "tf2_msgs/msg/TFMessage", LATCHED),
-    ]
-    if with_map:
-        topics.append(Topic(MAP, "nav_msgs/msg/OccupancyGrid", LATCHED))
-    for robot in robots:
-        topics.append(Topic(robot.odom, "nav_msgs/msg/Odometry", RELIABLE_10))
-        topics.append(Topic(robot.ground_truth, "nav_msgs/msg/Odometry", RELIABLE_10))
-        topics.append(Topic(robot.stall, "std_msgs/msg/Bool", RELIABLE_10))
-        topics.extend(Topic(scan, "sensor_msgs/msg/LaserScan", RELIABLE_10) for scan in robot.scans)
-    return topics
-
-
-def select(topics: list[Topic], wanted: list[str] | None, namespace: str = "/") -> list[Topic]:
+def select(recorded: list[Topic], wanted: list[str] | None, namespace: str = "/") -> list[Topic]:
     """The topics named in ``wanted`` (relative names are resolved in ``namespace``; None: all of them).
 
     Raises ValueError naming the unknown ones and what could be recorded instead."""
     if not wanted:
-        return topics
-    known = [t.name for t in topics]
+        return recorded
+    known = [t.name for t in recorded]
     resolved = {qualify(namespace, name): name for name in wanted}
     unknown = [name for full, name in resolved.items() if full not in known]
     if unknown:
         raise ValueError(f"no such topic {', '.join(unknown)}; this world publishes {', '.join(known)}")
-    return [t for t in topics if t.name in resolved]
+    return [t for t in recorded if t.name in resolved]

@@ -43,8 +43,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     from stage_sim.bags.errors import BagError
-    from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
+    from stage_sim.interface.names import robot_names
     from stage_sim.runs.pacing import Pacer, run_end, run_speedup, threads_for_run
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world

@@ -2,7 +2,7 @@
 
 No ``ros2 bag`` needed (it is not among the PyPI wheels): the ROS-free :class:`~stage_sim.bags.recorder.
 BagRecorder` records the node's simulation after every step, with the node's names, namespace and /map
-setting, so the bag holds what the node publishes (the same field values: :mod:`stage_sim.bags.fields`).
+setting, so the bag holds what the node publishes (the same field values: :mod:`stage_sim.interface.fields`).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
                        "rosbags)") from error
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
-                           topics=args.bag_topics, with_map=stage.map_pub is not None, prog=prog,
+                           topics=args.bag_topics, with_map=stage.publish_map, prog=prog,
                            lossless=stage.pacer.speedup <= 0)
     stage.add_step_listener(recorder.record_step)
     try:

@@ -1,6 +1,6 @@
 """Pure conversions from simulation state to ROS messages: no node, no publishing, easy to test.
 
-The values come from :mod:`stage_sim.bags.fields`, which the ROS-free bag writer uses too.
+The values come from :mod:`stage_sim.interface.fields`, which the ROS-free bag writer uses too.
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Quaternion, TransformStamped
 from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
 from nav_msgs.msg import Odometry
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import LaserScan
 
-from stage_sim.bags import fields
+from stage_sim.interface import fields
+from stage_sim.interface.frames import Edge
 from stage_sim.sim.rangers import Scan
 from stage_sim.sim.robots import RangerSpec
 from stage_sim.worldfile.occupancy import OccupancyGrid
@@ -26,11 +26,6 @@ def stamp(sim_time_us: int) -> Time:
     """builtin_interfaces/Time of a sim time in integer microseconds (exact, no float rounding)."""
     sec, nanosec = fields.stamp_parts(sim_time_us)
     return Time(sec=sec, nanosec=nanosec)
-
-
-def clock_msg(sim_time_us: int) -> Clock:
-    """The /clock message of one step."""
-    return Clock(clock=stamp(sim_time_us))
 
 
 def yaw_quaternion(yaw: float) -> Quaternion:
@@ -82,22 +77,17 @@ def fill_planar_transform(t: TransformStamped, x: float, y: float, yaw: float, t
     return t
 
 
-def transform(parent: str, child: str, x: float, y: float, z: float, yaw: float, time: Time) -> TransformStamped:
-    """One TF edge ``parent → child``."""
+def edge_transform(edge: Edge, time: Time) -> TransformStamped:
+    """One TF edge ``parent → child`` at ``time``."""
     t = TransformStamped()
     t.header.stamp = time
-    t.header.frame_id = parent
-    t.child_frame_id = child
-    t.transform.translation.x = float(x)
-    t.transform.translation.y = float(y)
-    t.transform.translation.z = float(z)
-    t.transform.rotation = yaw_quaternion(float(yaw))
+    t.header.frame_id = edge.parent
+    t.child_frame_id = edge.child
+    t.transform.translation.x = float(edge.x)
+    t.transform.translation.y = float(edge.y)
+    t.transform.translation.z = float(edge.z)
+    t.transform.rotation = yaw_quaternion(float(edge.yaw))
     return t
-
-
-def edge_transform(edge: fields.Edge, time: Time) -> TransformStamped:
-    """A fixed TF edge (/tf_static) at ``time``."""
-    return transform(edge.parent, edge.child, edge.x, edge.y, edge.z, edge.yaw, time)
 
 
 def occupancy_grid_msg(grid: OccupancyGrid, frame_id: str, time: Time) -> OccupancyGridMsg:

@@ -26,6 +26,8 @@ from rclpy.signals import SignalHandlerOptions
 
 from stage_sim.bags.errors import BagError
 from stage_sim.cli.arguments import add_duration_argument, add_seed_argument, add_speedup_argument
+from stage_sim.interface.names import numbered
+from stage_sim.interface.topics import ODOM, SCAN
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.recording import add_record_arguments, recording
@@ -55,13 +57,13 @@ class WanderSession:
         sim = self.stage.sim
         self.wanderers = []
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
-            prefix = names.cmd_vel[: -len("cmd_vel")]
-            remap = ["--ros-args", "-r", f"base_scan:={names.scans[0][len(prefix):]}"] if robot.rangers else None
+            first_scan = numbered(SCAN.name, len(robot.rangers))[0]
+            remap = ["--ros-args", "-r", f"{SCAN.name}:={first_scan}"] if robot.rangers else None
             overrides = [Parameter("holonomic", value=robot.drive.holonomic)]
             if seed is not None:
                 overrides.append(Parameter("seed", value=wanderer_seed(seed, index)))
             self.wanderers.append(Wander(
-                f"wander_{index}", namespace=prefix.rstrip("/") or None, context=context, cli_args=remap,
+                f"wander_{index}", namespace=names.label or None, context=context, cli_args=remap,
                 parameter_overrides=overrides))
         self.controller_names = [w.get_name() for w in self.wanderers]  # kept for messages after a node has gone
         self.executor = SingleThreadedExecutor(context=context)
@@ -98,11 +100,12 @@ class WanderSession:
 
     def _connect(self) -> None:
         """Spin until every scan, odometry and command topic has matched (discovery, even in-process)."""
-        stage = self.stage
+        publishers = self.stage.publishers_by_name
+        watched = [[publishers[name] for name in (*ODOM.names_on(names), *SCAN.names_on(names)[:1])]
+                   for names in self.stage.names]
         deadline = time.monotonic() + CONNECT_TIMEOUT_S
         while time.monotonic() < deadline and not all(
-            stage.odom_pubs[i].get_subscription_count() and w.publisher.get_subscription_count()
-            and all(p.get_subscription_count() for p in stage.scan_pubs[i][:1])
+            w.publisher.get_subscription_count() and all(p.get_subscription_count() for p in watched[i])
             for i, w in enumerate(self.wanderers)
         ):
             self.executor.spin_once(timeout_sec=0.01)

@@ -16,27 +16,24 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
-from nav_msgs.msg import OccupancyGrid as OccupancyGridMsg
-from nav_msgs.msg import Odometry
+from geometry_msgs.msg import Twist
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.timer import Timer
-from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import LaserScan
-from std_msgs.msg import Bool
 from std_srvs.srv import Empty
-from tf2_msgs.msg import TFMessage
 
-from stage_sim.bags import fields
-from stage_sim.bags.names import RobotNames, robot_names
+from stage_sim.interface import qos, topics
+from stage_sim.interface.names import RobotNames, robot_names
+from stage_sim.interface.topics import Endpoint, Fill, Scope, Timing, Topic
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
+from stage_sim.ros.qos import qos_profile
 from stage_sim.ros.rival_publishers import RivalPublishers
+from stage_sim.ros.topic_messages import TOPIC_MESSAGES, message_class
 from stage_sim.runs.pacing import WATCHDOG_S, Pacer, run_end, run_speedup, threads_for_run
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world
@@ -46,28 +43,20 @@ ABSURD_COMMAND = 1e3
 # At most one warning per robot in this many wall seconds about rejected commands.
 WARNING_THROTTLE_S = 5.0
 
-RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 # rclpy gives every publisher and subscription default QoS-event handlers, each a waitable the executor
 # re-adds to its wait set before every callback: with hundreds of per-robot endpoints that cost more than
 # the simulation step. Per-robot endpoints go without them; the world-wide ones keep the default warnings.
 NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
 NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
-TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
-# Every request is a caller waiting for its answer: the default services queue (the last 10) drops requests
-# whenever the executor lags (numba loading on its thread, a command flood), and those callers hang forever.
-EVERY_REQUEST = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 
 
 @dataclass
-class _RobotMessages:
-    """The messages one robot publishes every step, allocated once."""
+class _Channel:
+    """One published topic: its filler and, per endpoint, the publisher and the message built once for it."""
 
-    odom: Odometry
-    truth: Odometry
-    stall: Bool
-    odom_tf: TransformStamped
-    scans: list[LaserScan]
+    topic: Topic
+    fill: Fill
+    outlets: list[tuple[Publisher, Any, Endpoint]]
 
 
 class StageRos(Node):
@@ -114,7 +103,8 @@ class StageRos(Node):
         self._timer = self._step_timer(autostep)
         self._catch_up = self.create_guard_condition(self._step_due)
         self._publish_static()
-        self.rivals = RivalPublishers(self, ["/clock"], [t for n in self.names for t in (n.odom, *n.scans[:1])])
+        self.rivals = RivalPublishers(self, [topics.CLOCK.name], [
+            t for n in self.names for t in (*topics.ODOM.names_on(n), *topics.SCAN.names_on(n)[:1])])
         self.get_logger().info(
             f"{self.world_path.name}: {len(robots)} robot(s), interval_sim {self.sim.interval * 1000:g} ms, "
             f"speedup {speedup:g}" + (" (as fast as possible)" if speedup <= 0 else ""))
@@ -122,37 +112,31 @@ class StageRos(Node):
     # -- set-up --------------------------------------------------------------------------------------------
 
     def _create_interfaces(self, stamped: bool) -> None:
-        self.clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_10)
-        self.tf_pub = self.create_publisher(TFMessage, "/tf", TF_QOS)
-        self.tf_static_pub = self.create_publisher(TFMessage, "/tf_static", LATCHED)
-        self.map_pub = self.create_publisher(OccupancyGridMsg, "/map", LATCHED) if self.publish_map else None
-        self.odom_pubs, self.truth_pubs, self.stall_pubs, self.scan_pubs = [], [], [], []
-        for index, names in enumerate(self.names):
-            self.odom_pubs.append(self._robot_publisher(Odometry, names.odom))
-            self.truth_pubs.append(self._robot_publisher(Odometry, names.ground_truth))
-            self.stall_pubs.append(self._robot_publisher(Bool, names.stall))
-            self.scan_pubs.append([self._robot_publisher(LaserScan, topic) for topic in names.scans])
-            if stamped:
+        """A publisher per endpoint of every published topic, its message built once (publishing serialises,
+        so refilling is safe), a subscription per endpoint of every subscribed topic, and the reset service."""
+        self.publishers_by_name: dict[str, Publisher] = {}
+        self._channels: list[_Channel] = []
+        for topic in topics.published(self.publish_map):
+            outlets = []
+            for endpoint in topics.endpoints(topic, self.names):
+                publisher = self.create_publisher(
+                    message_class(topic), endpoint.name, qos_profile(topic.qos),
+                    event_callbacks=None if topic.scope is Scope.WORLD else NO_PUB_EVENTS)
+                self.publishers_by_name[endpoint.name] = publisher
+                outlets.append((publisher, TOPIC_MESSAGES[topic].build(endpoint, self.sim, self.names), endpoint))
+            self._channels.append(_Channel(topic, TOPIC_MESSAGES[topic].fill, outlets))
+        self._stepped = [channel for channel in self._channels if channel.topic.timing is not Timing.START]
+        handlers: dict[Topic, Callable[[int, Any], None]] = {
+            topics.CMD_VEL: self.on_command,
+            topics.CMD_VEL_STAMPED: lambda robot, msg: self.on_command(robot, msg.twist),
+        }
+        for topic in topics.subscribed(stamped):
+            for endpoint in topics.endpoints(topic, self.names):
                 self.create_subscription(
-                    TwistStamped, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg.twist), RELIABLE_10,
-                    event_callbacks=NO_SUB_EVENTS)
-            else:
-                self.create_subscription(
-                    Twist, names.cmd_vel, lambda msg, i=index: self.on_command(i, msg), RELIABLE_10,
-                    event_callbacks=NO_SUB_EVENTS)
-        self.create_service(Empty, "reset_positions", self.on_reset, qos_profile=EVERY_REQUEST)
-        # Messages are built once and refilled every step: publishing serialises them, so reuse is safe.
-        self._out = [
-            _RobotMessages(
-                odom=conversions.odometry_msg(names.odom_frame, names.base_footprint),
-                truth=conversions.odometry_msg(fields.WORLD_FRAME, names.base_footprint),
-                stall=Bool(),
-                odom_tf=conversions.transform(names.odom_frame, names.base_footprint, 0, 0, 0, 0, conversions.stamp(0)),
-                scans=[conversions.scan_msg(r, f) for r, f in zip(robot.rangers, names.laser_frames, strict=True)],
-            )
-            for robot, names in zip(self.sim.robots, self.names, strict=True)
-        ]
-        self._tf = TFMessage(transforms=[out.odom_tf for out in self._out])
+                    message_class(topic), endpoint.name, lambda msg, i=endpoint.robot, h=handlers[topic]: h(i, msg),
+                    qos_profile(topic.qos), event_callbacks=NO_SUB_EVENTS)
+        self.create_service(Empty, topics.RESET_POSITIONS, self.on_reset,
+                            qos_profile=qos_profile(qos.EVERY_REQUEST))
 
     def destroy_node(self) -> None:
         """Destroy the subscriptions before the publishers: Fast DDS takes time in proportion to the
@@ -173,21 +157,19 @@ class StageRos(Node):
         if self.pacer.behind():
             self._catch_up.trigger()
 
-    def _robot_publisher(self, msg_type: type, topic: str) -> Publisher:
-        return self.create_publisher(msg_type, topic, RELIABLE_10, event_callbacks=NO_PUB_EVENTS)
-
     def _publish_static(self) -> None:
-        """One latched /tf_static message with every robot's fixed frames (and /map if asked)."""
+        """The latched topics, once: one /tf_static message with every robot's fixed frames (and /map if asked)."""
         time = conversions.stamp(self.sim.sim_time_us)
-        edges = fields.static_edges(self.sim.robots, self.names)
-        self.tf_static_pub.publish(TFMessage(transforms=[conversions.edge_transform(e, time) for e in edges]))
-        if self.map_pub is not None:
+        for channel in self._channels:
+            if channel.topic.timing is not Timing.START:
+                continue
             try:
-                grid = self.sim.static.to_occupancy_grid()
+                values = channel.topic.values(self.sim, self.names)
             except WorldTooLargeError as error:  # the simulation runs on; only the picture is refused
-                self.get_logger().warning(f"not publishing /map: {error}")
-                return
-            self.map_pub.publish(conversions.occupancy_grid_msg(grid, fields.WORLD_FRAME, time))
+                self.get_logger().warning(f"not publishing {channel.topic.name}: {error}")
+                continue
+            for publisher, msg, endpoint in channel.outlets:
+                publisher.publish(channel.fill(msg, values, endpoint, time))
 
     # -- callbacks -----------------------------------------------------------------------------------------
 
@@ -205,7 +187,7 @@ class StageRos(Node):
         if now - self._last_warning[robot] >= WARNING_THROTTLE_S:
             self._last_warning[robot] = now
             self.get_logger().warning(
-                f"{self.names[robot].cmd_vel}: rejected command {values} (not finite or above "
+                f"{self.names[robot].topic(topics.CMD_VEL.name)}: rejected command {values} (not finite or above "
                 f"{ABSURD_COMMAND:g}); keeping the previous one")
 
     def on_reset(self, request: Empty.Request, response: Empty.Response) -> Empty.Response:
@@ -248,27 +230,16 @@ class StageRos(Node):
             self.get_logger().info(f"{reason} {self.pacer.end:g} s reached")
 
     def _publish_step(self) -> None:
-        sim = self.sim
+        """Every per-step topic, in the registry's order. A message nobody has subscribed to is neither filled
+        nor serialised (asking DDS costs ~1.5 µs, a publish 15-80 µs): with a hundred robots most topics have no
+        reader, and lockstep runs go 2x faster."""
+        sim, names = self.sim, self.names
         time = conversions.stamp(sim.sim_time_us)
-        self.clock_pub.publish(conversions.clock_msg(sim.sim_time_us))
-        true_velocity = sim.true_velocities
-        # A message nobody has subscribed to is neither filled nor serialised (asking DDS costs ~1.5 µs, a
-        # publish 15-80 µs): with a hundred robots most topics have no reader, and lockstep runs go 2x faster.
-        tf_wanted = self.tf_pub.get_subscription_count() > 0
-        for i, out in enumerate(self._out):
-            odom = sim.odometry_poses[i]
-            if self.odom_pubs[i].get_subscription_count():
-                self.odom_pubs[i].publish(conversions.fill_odometry(out.odom, odom, sim.velocities[i], time))
-            if self.truth_pubs[i].get_subscription_count():
-                self.truth_pubs[i].publish(
-                    conversions.fill_odometry(out.truth, sim.true_poses[i], true_velocity[i], time))
-            if self.stall_pubs[i].get_subscription_count():
-                out.stall.data = bool(sim.stalled[i])
-                self.stall_pubs[i].publish(out.stall)
-            if tf_wanted:
-                conversions.fill_planar_transform(out.odom_tf, odom[0], odom[1], odom[2], time)
-            for scan, pub, msg in zip(sim.scans[i], self.scan_pubs[i], out.scans, strict=True):
-                if fields.is_fresh(scan, sim) and pub.get_subscription_count():
-                    pub.publish(conversions.fill_scan(msg, scan, time))
-        if tf_wanted:
-            self.tf_pub.publish(self._tf)
+        for channel in self._stepped:
+            values = channel.topic.values(sim, names)
+            fill = channel.fill
+            for publisher, msg, endpoint in channel.outlets:
+                if publisher.get_subscription_count():
+                    filled = fill(msg, values, endpoint, time)
+                    if filled is not None:
+                        publisher.publish(filled)

@@ -29,10 +29,11 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
+from stage_sim.interface.topics import CMD_VEL
+from stage_sim.ros.qos import qos_profile
 from stage_sim.runs.interrupts import sigterm_interrupts
 
 NODE_NAME = "teleop_twist_keyboard"  # the original's name, so its parameter files apply unchanged
@@ -194,8 +195,7 @@ class TeleopTwistKeyboard(Node):
             raise ValueError("'frame_id' can only be set when 'stamped' is true")
         self.state = TeleopState(speed=speed, turn=turn)
         self.publisher = self.create_publisher(
-            TwistStamped if self.stamped else Twist, "cmd_vel",
-            QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
+            TwistStamped if self.stamped else Twist, CMD_VEL.name, qos_profile(CMD_VEL.qos))
 
     def publish_velocity(self, velocity: tuple[float, float, float, float]) -> None:
         """Publish (linear x, y, z, angular z), stamped with the node clock when ``stamped``."""

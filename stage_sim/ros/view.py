@@ -72,7 +72,7 @@ def viewing(stage: StageRos, args: argparse.Namespace) -> Iterator[LiveView | No
         yield None
         return
 
-    names = [name.cmd_vel[: -len("cmd_vel")].rstrip("/") or robot.name or "robot"
+    names = [name.label or robot.name or "robot"
              for name, robot in zip(stage.names, stage.sim.robots, strict=True)]
     view = LiveView(stage.sim, RosControls(stage), view_settings(args), names)
     try:

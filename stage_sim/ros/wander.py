@@ -31,23 +31,20 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Bool
 from tf2_msgs.msg import TFMessage
 
+from stage_sim.interface.qos import NEWEST_ONLY
+from stage_sim.interface.topics import CMD_VEL, ODOM, SCAN, STALL, TF_STATIC
+from stage_sim.ros.qos import qos_profile
 from stage_sim.runs.interrupts import stop_requests
 from stage_sim.wander.config import WanderConfig
 from stage_sim.wander.laser_reading import LaserReading
 from stage_sim.wander.reactive import Wanderer
 
-RELIABLE_10 = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-# Only the newest scan matters: a backlog (a slow start, a loaded machine) would replay stale scans, each
-# answered with a command for where the robot no longer is.
-NEWEST_SCAN = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 ODOM_KEPT = 50  # recent odometry messages kept for pairing with scans by stamp
 NO_SCAN_WARNING_S = 5.0  # wall seconds without a scan before the console script says what it is missing
 
@@ -83,12 +80,13 @@ class Wander(Node):
         self._pending: LaserScan | None = None  # a scan waiting for the odometry of its stamp
         self._stalled = False  # whether a stall was reported since the last decision
         self.decisions = 0  # commands published so far
-        self.publisher = self.create_publisher(Twist, "cmd_vel", RELIABLE_10)
+        self.publisher = self.create_publisher(Twist, CMD_VEL.name, qos_profile(CMD_VEL.qos))
         # Created first: when a step's stall and scan are both waiting, the executor takes the stall first.
-        self.create_subscription(Bool, "stall", self.on_stall, RELIABLE_10)
-        self.create_subscription(LaserScan, "base_scan", self.on_scan, NEWEST_SCAN)
-        self.create_subscription(Odometry, "odom", self.on_odom, RELIABLE_10)
-        self.create_subscription(TFMessage, "/tf_static", self.on_tf_static, LATCHED)
+        self.create_subscription(Bool, STALL.name, self.on_stall, qos_profile(STALL.qos))
+        # Only the newest scan matters (not the depth stageros offers): see NEWEST_ONLY.
+        self.create_subscription(LaserScan, SCAN.name, self.on_scan, qos_profile(NEWEST_ONLY))
+        self.create_subscription(Odometry, ODOM.name, self.on_odom, qos_profile(ODOM.qos))
+        self.create_subscription(TFMessage, TF_STATIC.name, self.on_tf_static, qos_profile(TF_STATIC.qos))
 
     def on_tf_static(self, msg: TFMessage) -> None:
         """Remember where every statically mounted frame sits (the scan's frame among them)."""
@@ -156,8 +154,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with stop_requests() as stop:
             node = Wander()
-            scans = node.resolve_topic_name("base_scan")
-            node.get_logger().info(f"waiting for scans on {scans}; commands go to {node.resolve_topic_name('cmd_vel')}")
+            scans, commands = node.resolve_topic_name(SCAN.name), node.resolve_topic_name(CMD_VEL.name)
+            node.get_logger().info(f"waiting for scans on {scans}; commands go to {commands}")
             executor = SingleThreadedExecutor()
             executor.add_node(node)
             started, warned = time.monotonic(), False

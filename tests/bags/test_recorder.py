@@ -12,8 +12,8 @@ import yaml
 from mcap.reader import make_reader
 
 from stage_sim.bags.errors import BagError
-from stage_sim.bags.names import robot_names
 from stage_sim.bags.recorder import BagRecorder
+from stage_sim.interface.names import robot_names
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world
 from tests.bags.readers import READERS, ReadBag

@@ -63,8 +63,8 @@ def test_the_bag_holds_exactly_what_stageros_publishes(ros_context, executor, tm
 
 
 def test_the_bag_names_the_types_with_ros_own_hashes(tmp_path) -> None:
-    from stage_sim.bags.names import robot_names
     from stage_sim.bags.recorder import BagRecorder
+    from stage_sim.interface.names import robot_names
     from stage_sim.sim.simulation import Simulation
     from stage_sim.worldfile.loader import load_world
 

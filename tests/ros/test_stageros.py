@@ -85,7 +85,7 @@ def test_laser_scan_fields(ros_context, executor, tmp_path) -> None:
     sim = make_sim(ros_context, executor, write_world(tmp_path, 'bot( pose [2 5 0 0] )'))
     probe = Probe(ros_context, executor)
     scans = probe.listen(LaserScan, "base_scan")
-    assert spin_until(executor, lambda: sim.scan_pubs[0][0].get_subscription_count() > 0)
+    assert spin_until(executor, lambda: sim.publishers_by_name["base_scan"].get_subscription_count() > 0)
     scan = step(executor, sim, probe, "base_scan")[-1]
     assert scan.header.frame_id == "base_laser_link"
     assert stamp_s(scan) == pytest.approx(0.1)
@@ -143,7 +143,7 @@ def test_tf_tree_shape_and_values(ros_context, executor, tmp_path) -> None:
     # x from the ranger pose, z = robot height 0.2 + ranger z −0.1
     assert (laser.translation.x, laser.translation.y, laser.translation.z) == pytest.approx((0.1, 0.0, 0.1))
     assert edges[("base_footprint", "base_link")].rotation.w == pytest.approx(1.0)
-    assert spin_until(executor, lambda: sim.tf_pub.get_subscription_count() > 0)
+    assert spin_until(executor, lambda: sim.publishers_by_name["/tf"].get_subscription_count() > 0)
     sim.sim.set_velocity(0, 0.5, 0.0, 0.0)
     step(executor, sim, probe, "/tf")
     (odom_tf,) = tf[-1].transforms
@@ -237,8 +237,8 @@ def test_three_robot_names(ros_context, executor, tmp_path) -> None:
 def test_model_names_with_use_model_names(ros_context, executor, tmp_path) -> None:
     world = write_world(tmp_path, 'bot( pose [2 2 0 0] name "alice" ) bot( pose [5 5 0 0] )')
     sim = make_sim(ros_context, executor, world, use_model_names=True)
-    assert sim.names[0].odom == "alice/odom" and sim.names[0].laser_frames == ("alice/base_laser_link",)
-    assert sim.names[1].odom == "robot_1/odom"  # Stage's automatic token is not a valid ROS name
+    assert sim.names[0].topic("odom") == "alice/odom" and sim.names[0].laser_frames == ("alice/base_laser_link",)
+    assert sim.names[1].topic("odom") == "robot_1/odom"  # Stage's automatic token is not a valid ROS name
 
 
 def test_two_rangers_get_indexed_names(ros_context, executor, tmp_path) -> None:

@@ -45,7 +45,7 @@ def test_one_command_per_scan_within_the_parameters(ros_context, executor) -> No
         executor.add_node(node)
     received: list[Twist] = []
     probe.create_subscription(Twist, "cmd_vel", received.append, 100)
-    assert spin_until(executor, lambda: stage.odom_pubs[0].get_subscription_count() > 0
+    assert spin_until(executor, lambda: stage.publishers_by_name["odom"].get_subscription_count() > 0
                       and wander.publisher.get_subscription_count() > 1, 10.0)
     start = stage.sim.true_poses[0].copy()
     lockstep(executor, stage, {"cmd_vel": received}, 100)

@@ -9,16 +9,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stage_sim.bags.names import RobotNames
-from stage_sim.sim.rangers import Scan
-from stage_sim.sim.robots import RangerSpec, RobotSpec
-from stage_sim.sim.simulation import Simulation
-
-WORLD_FRAME = "world"
-"""The frame of ground truth and /map."""
+if TYPE_CHECKING:
+    from stage_sim.sim.rangers import Scan
+    from stage_sim.sim.robots import RangerSpec
+    from stage_sim.sim.simulation import Simulation
 
 
 def stamp_parts(sim_time_us: int) -> tuple[int, int]:
@@ -68,31 +66,27 @@ def scan_arrays(scan: Scan) -> tuple[np.ndarray, np.ndarray]:
     return scan.ranges.astype(np.float32), scan.intensities.astype(np.float32)
 
 
-def is_fresh(scan: Scan, sim: Simulation) -> bool:
-    """Whether a ranger measured in the step just taken (rangers slower than interval_sim skip steps)."""
-    return scan.stamp == sim.sim_time
 
 
 @dataclass(frozen=True)
-class Edge:
-    """One TF edge ``parent → child`` at (x, y, z, yaw)."""
+class LatestScans:
+    """Every ranger's latest scan (``scans[robot][ranger]``) and the step's sim time: a ranger publishes only
+    in the steps it measured in (rangers slower than interval_sim skip steps)."""
 
-    parent: str
-    child: str
-    x: float
-    y: float
-    z: float
-    yaw: float
+    scans: list[list[Scan]]
+    time: float
+
+    def measured(self, robot: int, ranger: int) -> Scan | None:
+        """The scan ranger ``ranger`` of robot ``robot`` took in this step, None if it took none."""
+        scan = self.scans[robot][ranger]
+        return scan if scan.stamp == self.time else None
+
+    def snapshot(self) -> LatestScans:
+        """The same step's measurements, safe to keep after the simulation steps on (scans are never changed,
+        only replaced: copying the lists is enough)."""
+        return LatestScans([list(robot) for robot in self.scans], self.time)
 
 
-def static_edges(robots: list[RobotSpec], names: list[RobotNames]) -> list[Edge]:
-    """Every fixed frame of every robot, as /tf_static carries them in one latched message:
-    ``base_footprint → base_link`` (identity) and ``base_link → base_laser_link[_k]`` (the ranger's pose,
-    z already including the robot height)."""
-    edges = []
-    for robot, robot_names in zip(robots, names, strict=True):
-        edges.append(Edge(robot_names.base_footprint, robot_names.base_link, 0.0, 0.0, 0.0, 0.0))
-        for ranger, frame in zip(robot.rangers, robot_names.laser_frames, strict=True):
-            pose = ranger.pose
-            edges.append(Edge(robot_names.base_link, frame, pose.x, pose.y, pose.z, pose.yaw))
-    return edges
+def latest_scans(sim: Simulation) -> LatestScans:
+    """The scans of the step just taken."""
+    return LatestScans(sim.scans, sim.sim_time)

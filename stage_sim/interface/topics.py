@@ -1,0 +1,137 @@
+"""The one registry of the topics stageros publishes and subscribes, without ROS.
+
+Each :class:`Topic` says its name rule (absolute for the world, relative under a robot's prefix, numbered per
+ranger), its message type, its QoS, when it is published and which values of a :class:`Simulation` its
+messages carry. The ROS node (:mod:`stage_sim.ros.stageros`) advertises and publishes them in a loop over
+this registry, the bag recorder (:mod:`stage_sim.bags`) records the same list; each side keeps one message
+filler per topic (:mod:`stage_sim.ros.topic_messages`, :mod:`stage_sim.bags.messages`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from enum import Enum
+from typing import TYPE_CHECKING, Any
+
+from stage_sim.interface import fields, frames
+from stage_sim.interface.names import RobotNames
+from stage_sim.interface.qos import LATCHED, RELIABLE_10, TF_STREAM, Qos
+
+if TYPE_CHECKING:
+    from stage_sim.sim.simulation import Simulation
+
+
+class Scope(Enum):
+    """How many of a topic there are."""
+
+    WORLD = "world"  # one, absolute name
+    ROBOT = "robot"  # one per robot, under its prefix
+    RANGER = "ranger"  # one per ranger of a robot, numbered when it has several
+
+
+class Timing(Enum):
+    """When a published topic sends."""
+
+    STEP = "every step"
+    MEASURED = "in the steps its ranger measured in"
+    """Its values answer ``measured(robot, ranger)`` with this step's measurement or None."""
+    START = "once at start, latched"
+
+
+Values = Callable[["Simulation", Sequence[RobotNames]], Any]
+"""What one publication of a topic is made of (world topics: the value; robot topics: indexed by robot)."""
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One topic of stageros' interface."""
+
+    name: str
+    """``/clock`` (world: absolute), ``odom`` (per robot: under its prefix), ``base_scan`` (per ranger:
+    ``base_scan_<k>`` on a robot with several)."""
+    msgtype: str
+    qos: Qos
+    scope: Scope
+    timing: Timing = Timing.STEP
+    values: Values | None = None
+    """None for the topics stageros subscribes."""
+    on_request: bool = False
+    """Published only when asked for (/map: the ``publish_map`` parameter, ``--map``)."""
+
+    def names_on(self, robot: RobotNames) -> tuple[str, ...]:
+        """The topic's names on one robot (one per ranger for a per-ranger topic)."""
+        if self.scope is Scope.RANGER:
+            return robot.ranger_topics(self.name)
+        return (robot.topic(self.name),)
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """One advertised instance of a topic: its full relative or absolute name and whose it is."""
+
+    topic: Topic
+    name: str
+    robot: int | None = None
+    ranger: int | None = None
+
+
+Build = Callable[[Endpoint, "Simulation", Sequence[RobotNames]], Any]
+"""(endpoint, simulation, robot names) → the endpoint's message with everything that never changes."""
+Fill = Callable[[Any, Any, Endpoint, Any], Any]
+"""(built message, the topic's values this step, endpoint, stamp) → the message to send, None for none."""
+
+
+@dataclass(frozen=True)
+class TopicMessage:
+    """How one writer of messages (rclpy in :mod:`stage_sim.ros`, rosbags in :mod:`stage_sim.bags`) makes a
+    topic's message: built once per endpoint, refilled for every publication."""
+
+    build: Build
+    fill: Fill
+
+
+def endpoints(topic: Topic, names: Sequence[RobotNames]) -> list[Endpoint]:
+    """Every instance of ``topic`` in a world whose robots are called ``names``, robot by robot."""
+    if topic.scope is Scope.WORLD:
+        return [Endpoint(topic, topic.name)]
+    return [Endpoint(topic, name, robot, k if topic.scope is Scope.RANGER else None)
+            for robot, robot_names in enumerate(names) for k, name in enumerate(topic.names_on(robot_names))]
+
+
+CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", RELIABLE_10, Scope.WORLD,
+              values=lambda sim, names: sim.sim_time_us)
+ODOM = Topic("odom", "nav_msgs/msg/Odometry", RELIABLE_10, Scope.ROBOT,
+             values=lambda sim, names: (sim.odometry_poses, sim.velocities))
+GROUND_TRUTH = Topic("base_pose_ground_truth", "nav_msgs/msg/Odometry", RELIABLE_10, Scope.ROBOT,
+                     values=lambda sim, names: (sim.true_poses, sim.true_velocities))
+STALL = Topic("stall", "std_msgs/msg/Bool", RELIABLE_10, Scope.ROBOT, values=lambda sim, names: sim.stalled)
+SCAN = Topic("base_scan", "sensor_msgs/msg/LaserScan", RELIABLE_10, Scope.RANGER, Timing.MEASURED,
+             values=lambda sim, names: fields.latest_scans(sim))
+TF = Topic("/tf", "tf2_msgs/msg/TFMessage", TF_STREAM, Scope.WORLD,
+           values=lambda sim, names: sim.odometry_poses)
+"""One message per step with every robot's ``odom → base_footprint``."""
+TF_STATIC = Topic("/tf_static", "tf2_msgs/msg/TFMessage", LATCHED, Scope.WORLD, Timing.START,
+                  values=lambda sim, names: frames.static_edges(sim.robots, list(names)))
+MAP = Topic("/map", "nav_msgs/msg/OccupancyGrid", LATCHED, Scope.WORLD, Timing.START,
+            values=lambda sim, names: sim.static.to_occupancy_grid(), on_request=True)
+
+PUBLISHED = (CLOCK, ODOM, GROUND_TRUTH, STALL, SCAN, TF, TF_STATIC, MAP)
+"""Every topic stageros publishes; the per-step ones in the order it publishes them each step."""
+
+CMD_VEL = Topic("cmd_vel", "geometry_msgs/msg/Twist", RELIABLE_10, Scope.ROBOT)
+CMD_VEL_STAMPED = Topic("cmd_vel", "geometry_msgs/msg/TwistStamped", RELIABLE_10, Scope.ROBOT)
+"""cmd_vel as TwistStamped (the ``use_stamped_velocity`` parameter), as ROS 2 Jazzy's controllers send it."""
+
+RESET_POSITIONS = "reset_positions"
+"""The std_srvs/srv/Empty service that puts every robot back at its start pose."""
+
+
+def published(with_map: bool) -> list[Topic]:
+    """The topics a node publishes (/map only ``with_map``), world-wide ones and per-robot ones alike."""
+    return [t for t in PUBLISHED if with_map or not t.on_request]
+
+
+def subscribed(stamped: bool) -> list[Topic]:
+    """The topics stageros subscribes."""
+    return [CMD_VEL_STAMPED if stamped else CMD_VEL]
