@@ -19,7 +19,8 @@ from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-_TYPE_NAMES = {bool: "a boolean (true/false)", int: "an integer", float: "a double", str: "a string"}
+_TYPE_NAMES = {bool: "a boolean (true/false)", int: "an integer", float: "a double", str: "a string",
+               list: "a list of doubles"}
 
 
 class ParameterTypeError(ValueError):
@@ -32,17 +33,25 @@ class ParameterSpec:
     time is applied (``on_change``) or refused (read-only)."""
 
     name: str
-    default: bool | int | float | str
+    default: bool | int | float | str | list[float]
     description: str
     on_change: Callable[[Any], None] | None = None
 
 
-def coerce(spec: ParameterSpec, value: Any) -> bool | int | float | str:
-    """``value`` as the spec's type: an integer widens to a double; a bool is never taken for a number."""
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def coerce(spec: ParameterSpec, value: Any) -> bool | int | float | str | list[float]:
+    """``value`` as the spec's type: an integer widens to a double (also in a list of doubles); a bool is never
+    taken for a number."""
     wanted = type(spec.default)
-    if wanted is float and isinstance(value, int) and not isinstance(value, bool):
+    if wanted is float and _is_number(value):
         return float(value)
-    if isinstance(value, wanted) and (wanted is bool or not isinstance(value, bool)):
+    if wanted is list and not isinstance(value, str | bytes) and hasattr(value, "__iter__") and all(
+            _is_number(v) for v in value):
+        return [float(v) for v in value]
+    if wanted is not list and isinstance(value, wanted) and (wanted is bool or not isinstance(value, bool)):
         return value
     raise ParameterTypeError(
         f"parameter '{spec.name}' takes {_TYPE_NAMES[wanted]}, not {value!r} ({type(value).__name__})")

@@ -31,6 +31,7 @@ from stage_sim.interface.names import RobotNames, robot_names
 from stage_sim.interface.topics import Endpoint, Fill, Scope, Timing, Topic
 from stage_sim.maps.tiles import WorldTooLargeError
 from stage_sim.ros import conversions
+from stage_sim.ros.parameters import ParameterSpec, declare_parameters
 from stage_sim.ros.qos import qos_profile
 from stage_sim.ros.rival_publishers import RivalPublishers
 from stage_sim.ros.topic_messages import TOPIC_MESSAGES, message_class
@@ -72,21 +73,30 @@ class StageRos(Node):
         defaults to 1 in real time and to all cores with ``speedup <= 0``. The run ends at the world's
         ``quit_time`` or after ``duration`` sim seconds, whichever comes first."""
         super().__init__(node_name, **kwargs)
-        world_param = self.declare_parameter("world_file", str(world) if world is not None else "").value
+        (world_param,) = declare_parameters(self, [ParameterSpec(
+            "world_file", str(world) if world is not None else "", "the .world file, or a bundled world's name")
+        ]).values()
         if not world_param:
             raise ValueError("no world given: pass WORLD on the command line or set the 'world_file' parameter")
         description = load_world(world_param)
         self.world_path = description.path
-        speedup_default = run_speedup(speedup, description.settings.speedup)
-        speedup = float(self.declare_parameter("speedup", float(speedup_default)).value)
-        seed_value = int(self.declare_parameter("seed", -1 if seed is None else seed).value)
-        watchdog = float(self.declare_parameter("base_watchdog_timeout", WATCHDOG_S).value)
-        model_names = bool(self.declare_parameter("use_model_names", bool(use_model_names)).value)
-        self.publish_map = bool(self.declare_parameter("publish_map", False).value)
-        stamped = bool(self.declare_parameter("use_stamped_velocity", False).value)
+        params = declare_parameters(self, [
+            ParameterSpec("speedup", float(run_speedup(speedup, description.settings.speedup)),
+                          "sim seconds per wall second (<= 0: as fast as possible)", on_change=self.set_speedup),
+            ParameterSpec("seed", -1 if seed is None else seed, "seed of the odometry errors and noise (-1: random)"),
+            ParameterSpec("base_watchdog_timeout", WATCHDOG_S, "sim seconds a command lasts without a new one",
+                          on_change=lambda timeout: setattr(self.sim, "watchdog_timeout", timeout)),
+            ParameterSpec("use_model_names", bool(use_model_names), "name topics and frames after the models"),
+            ParameterSpec("publish_map", False, "publish the static world on /map (latched)"),
+            ParameterSpec("use_stamped_velocity", False, "cmd_vel is geometry_msgs/TwistStamped"),
+        ])
+        speedup, seed_value = params["speedup"], params["seed"]
+        model_names, stamped = params["use_model_names"], params["use_stamped_velocity"]
+        self.publish_map = params["publish_map"]
 
-        self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value, watchdog_timeout=watchdog,
-                              kernels=kernels, threads=threads_for_run(threads, speedup))
+        self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value,
+                              watchdog_timeout=params["base_watchdog_timeout"], kernels=kernels,
+                              threads=threads_for_run(threads, speedup))
         for warning in self.sim.warnings:
             self.get_logger().warning(str(warning))
         robots = self.sim.robots
@@ -114,6 +124,15 @@ class StageRos(Node):
     def _create_interfaces(self, stamped: bool) -> None:
         """A publisher per endpoint of every published topic, its message built once (publishing serialises,
         so refilling is safe), a subscription per endpoint of every subscribed topic, and the reset service."""
+        handlers: dict[Topic, Callable[[int, Any], None]] = {
+            topics.CMD_VEL: self.on_command,
+            topics.CMD_VEL_STAMPED: lambda robot, msg: self.on_command(robot, msg.twist),
+        }
+        for topic in topics.subscribed(stamped):
+            for endpoint in topics.endpoints(topic, self.names):
+                self.create_subscription(
+                    message_class(topic), endpoint.name, lambda msg, i=endpoint.robot, h=handlers[topic]: h(i, msg),
+                    qos_profile(topic.qos), event_callbacks=NO_SUB_EVENTS)
         self.publishers_by_name: dict[str, Publisher] = {}
         self._channels: list[_Channel] = []
         for topic in topics.published(self.publish_map):
@@ -126,15 +145,6 @@ class StageRos(Node):
                 outlets.append((publisher, TOPIC_MESSAGES[topic].build(endpoint, self.sim, self.names), endpoint))
             self._channels.append(_Channel(topic, TOPIC_MESSAGES[topic].fill, outlets))
         self._stepped = [channel for channel in self._channels if channel.topic.timing is not Timing.START]
-        handlers: dict[Topic, Callable[[int, Any], None]] = {
-            topics.CMD_VEL: self.on_command,
-            topics.CMD_VEL_STAMPED: lambda robot, msg: self.on_command(robot, msg.twist),
-        }
-        for topic in topics.subscribed(stamped):
-            for endpoint in topics.endpoints(topic, self.names):
-                self.create_subscription(
-                    message_class(topic), endpoint.name, lambda msg, i=endpoint.robot, h=handlers[topic]: h(i, msg),
-                    qos_profile(topic.qos), event_callbacks=NO_SUB_EVENTS)
         self.create_service(Empty, topics.RESET_POSITIONS, self.on_reset,
                             qos_profile=qos_profile(qos.EVERY_REQUEST))
 

@@ -39,6 +39,7 @@ from tf2_msgs.msg import TFMessage
 
 from stage_sim.interface.qos import NEWEST_ONLY
 from stage_sim.interface.topics import CMD_VEL, ODOM, SCAN, STALL, TF_STATIC
+from stage_sim.ros.parameters import ParameterSpec, ParameterTypeError, declare_parameters
 from stage_sim.ros.qos import qos_profile
 from stage_sim.runs.interrupts import stop_requests
 from stage_sim.wander.config import WanderConfig
@@ -64,16 +65,23 @@ class Wander(Node):
     def __init__(self, node_name: str = "wander", **kwargs: Any) -> None:
         super().__init__(node_name, **kwargs)
         defaults = WanderConfig()
-        seed = int(self.declare_parameter("seed", -1).value)
+        params = declare_parameters(self, [
+            ParameterSpec("seed", -1, "seed of the wanderer's random choices (-1: random)"),
+            ParameterSpec("forward_speed", defaults.forward_speed, "cruising speed, m/s"),
+            ParameterSpec("safety_distance", defaults.safety_distance, "clearance kept from obstacles, m"),
+            ParameterSpec("turn_rate", defaults.turn_rate, "turning speed, rad/s"),
+            ParameterSpec("holonomic", defaults.holonomic, "the robot can move sideways (omni drive)"),
+            ParameterSpec("footprint", [float(v) for box in defaults.footprint for v in box],
+                          "the body as rectangles, flattened [x_min, x_max, y_min, y_max, ...]"),
+            ParameterSpec("laser_pose", [0.23, 0.0, 0.0], "[x, y, yaw] of the laser until /tf_static gives it"),
+        ])
+        seed = params["seed"]
         config = WanderConfig(
-            forward_speed=float(self.declare_parameter("forward_speed", defaults.forward_speed).value),
-            safety_distance=float(self.declare_parameter("safety_distance", defaults.safety_distance).value),
-            turn_rate=float(self.declare_parameter("turn_rate", defaults.turn_rate).value),
-            holonomic=bool(self.declare_parameter("holonomic", defaults.holonomic).value),
-            footprint=tuple(np.reshape(self.declare_parameter(
-                "footprint", [float(v) for box in defaults.footprint for v in box]).value, (-1, 4)).tolist()),
+            forward_speed=params["forward_speed"], safety_distance=params["safety_distance"],
+            turn_rate=params["turn_rate"], holonomic=params["holonomic"],
+            footprint=tuple(np.reshape(params["footprint"], (-1, 4)).tolist()),
         )
-        self.default_laser_pose = tuple(self.declare_parameter("laser_pose", [0.23, 0.0, 0.0]).value)
+        self.default_laser_pose = tuple(params["laser_pose"])
         self.wanderer = Wanderer(config, seed=None if seed < 0 else seed)
         self.laser_poses: dict[str, tuple[float, float, float]] = {}  # frame -> pose on the robot, from /tf_static
         self._odometry: deque[tuple[int, tuple[float, float, float]]] = deque(maxlen=ODOM_KEPT)
@@ -167,6 +175,9 @@ def main(argv: list[str] | None = None) -> int:
                         f"no scan on {scans} after {NO_SCAN_WARNING_S:g} s: is stageros running, on the same "
                         f"ROS_DOMAIN_ID ({os.environ.get('ROS_DOMAIN_ID', '0')}), with this robot's namespace?")
         return 0
+    except ParameterTypeError as error:
+        print(f"wander: {error}", file=sys.stderr)
+        return 2
     except ExternalShutdownException:
         return 0
     finally:

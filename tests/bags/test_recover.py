@@ -112,9 +112,11 @@ def test_a_kill_9_at_real_time_loses_about_a_second(tmp_path) -> None:
     ~14 s) reaches the disk chunk after chunk within seconds, /tf_static first, and survives a kill -9."""
     bag_path = tmp_path / "killed.mcap"
     process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "1", "--bag", bag_path)
-    wait_for_chunks(bag_path, 3, process, timeout_s=15.0)  # the latched messages, then two chunks of steps
-    process.kill()
-    process.communicate()
+    try:
+        wait_for_chunks(bag_path, 3, process, timeout_s=15.0)  # the latched messages, then two chunks of steps
+    finally:
+        process.kill()
+        process.communicate()
     result = recover(bag_path, tmp_path / "out.mcap")
     bag = READERS["rosbags"](tmp_path / "out.mcap")
     assert len(bag.messages["/tf_static"]) == 1

@@ -3,6 +3,12 @@ and at run time."""
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
 import pytest
 from rclpy.context import Context
 from rclpy.node import Node
@@ -65,3 +71,46 @@ def test_at_run_time_a_wrong_type_is_refused_a_good_one_applied_and_start_only_o
         assert not result.successful and "read-only" in result.reason
     finally:
         node.destroy_node()
+
+
+def stageros(*args: str, timeout: float = 60) -> tuple[int | None, str]:
+    """stageros as users start it: its exit status (None if still up) and what it printed, stopped once up."""
+    process = subprocess.Popen([str(Path(sys.executable).with_name("stageros")), "-g", "rooms.world", *args],
+                               stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    lines = []
+    deadline = time.monotonic() + timeout
+    for line in process.stderr:
+        lines.append(line)
+        if "robot(s), interval_sim" in line or time.monotonic() > deadline:
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+            return None, "".join(lines)
+    return process.wait(), "".join(lines)
+
+
+def test_stageros_takes_integers_for_doubles_as_users_type_them() -> None:
+    status, output = stageros("--ros-args", "-p", "speedup:=2", "-p", "base_watchdog_timeout:=1")
+    assert status is None and output.rstrip().endswith("speedup 2") and "Traceback" not in output, output
+
+
+@pytest.mark.parametrize(("param", "message"), [
+    ("seed:=1.5", "parameter 'seed' takes an integer, not 1.5 (float)"),
+    ("publish_map:=1", "parameter 'publish_map' takes a boolean (true/false), not 1 (int)"),
+])
+def test_stageros_refuses_a_wrong_type_in_one_line(param: str, message: str) -> None:
+    status, output = stageros("--ros-args", "-p", param)
+    assert status == 2 and output.strip() == f"stageros: {message}", output
+
+
+def test_wander_takes_integer_lists_for_double_lists_and_refuses_a_wrong_type() -> None:
+    wander = str(Path(sys.executable).with_name("wander"))
+    refused = subprocess.run([wander, "--ros-args", "-p", "forward_speed:=fast"], capture_output=True, text=True,
+                             timeout=60, stdin=subprocess.DEVNULL)
+    assert refused.returncode == 2
+    assert refused.stderr.strip() == "wander: parameter 'forward_speed' takes a double, not 'fast' (str)"
+    process = subprocess.Popen([wander, "--ros-args", "-p", "forward_speed:=1", "-p", "laser_pose:=[0, 0, 1]"],
+                               stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    line = process.stderr.readline()
+    process.send_signal(signal.SIGINT)
+    process.communicate(timeout=30)
+    assert "waiting for scans" in line and process.returncode == 0, line
