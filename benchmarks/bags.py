@@ -5,10 +5,11 @@ Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 60
 case runs the console script in its own process (as users run it) and reads the sim and wall time it prints;
 one JSON object per line:
 
-- ``overhead``: rooms.world for ``--duration`` sim seconds, plain and with ``--bag``, ``--repeat`` times each
-  (interleaved; the best counts, as the machine is shared): sim seconds per wall second of each and
-  ``cost_pct``, how much slower the recording run is (the issue's target: <= 15); ``cpu_cost_pct``, the
-  same from the processes' CPU seconds (both threads), which the load of other processes disturbs less.
+- ``overhead``: rooms.world with one robot driven straight and by the wanderer for ``--duration`` sim seconds,
+  and 100 robots for ``--crowd-duration``, plain and with ``--bag``, ``--repeat`` times each (interleaved; the
+  best counts, as the machine is shared): sim seconds per wall second of each and ``cost_pct``, how much
+  slower the recording run is (the target: <= 15); ``cpu_cost_pct``, the same from the processes' CPU
+  seconds (both threads), which the load of other processes disturbs less.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
   LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
 """
@@ -60,10 +61,28 @@ def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict
     return out
 
 
+def overhead(world: Path, robots: int, controller: str, duration: float, repeat: int, bag: Path) -> dict:
+    """Plain and recorded runs of one case, interleaved, best of each (the machine is shared, its load varies)."""
+    plains, bags = [], []
+    for _ in range(repeat):
+        plains.append(run(world, duration, controller, None))
+        bags.append(run(world, duration, controller, bag))
+    plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
+    cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
+    return {
+        "case": "overhead", "world": world.name, "robots": robots, "controller": controller, "duration": duration,
+        "repeat": repeat, "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
+        "cost_pct": round(100 * (1 - recorded["sim_rate"] / plain["sim_rate"]), 1),
+        "cpu_s_plain": round(cpu_plain, 2), "cpu_s_bag": round(cpu_bag, 2),
+        "cpu_cost_pct": round(100 * (cpu_bag / cpu_plain - 1), 1),
+        "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=600.0, help="sim seconds of the overhead runs")
-    parser.add_argument("--controller", default="straight", choices=["straight", "wander"])
+    parser.add_argument("--duration", type=float, default=600.0, help="sim seconds of the one-robot overhead runs")
+    parser.add_argument("--crowd-duration", type=float, default=60.0,
+                        help="sim seconds of the 100-robot overhead runs")
     parser.add_argument("--repeat", type=int, default=3, help="overhead runs of each kind (best one counts)")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 100])
     parser.add_argument("--throughput-duration", type=float, default=None,
@@ -72,19 +91,13 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         tmp = Path(folder)
         rooms = REPO / "worlds" / "rooms.world"
-        plains, bags = [], []
-        for _ in range(args.repeat):  # interleaved, best of each: the machine is shared and its load varies
-            plains.append(run(rooms, args.duration, args.controller, None))
-            bags.append(run(rooms, args.duration, args.controller, tmp / "rooms.mcap"))
-        plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
-        cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
-        print(json.dumps({
-            "case": "overhead", "world": "rooms.world", "controller": args.controller, "duration": args.duration,
-            "repeat": args.repeat, "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
-            "cost_pct": round(100 * (1 - recorded["sim_rate"] / plain["sim_rate"]), 1),
-            "cpu_s_plain": round(cpu_plain, 2), "cpu_s_bag": round(cpu_bag, 2),
-            "cpu_cost_pct": round(100 * (cpu_bag / cpu_plain - 1), 1),
-            "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}), flush=True)
+        crowd = tmp / "robots_100.world"
+        crowd.write_text(world_text(100, 240, 240.0, 5.6, seed=1))
+        for world, robots, controller, duration in ((rooms, 1, "straight", args.duration),
+                                                    (rooms, 1, "wander", args.duration),
+                                                    (crowd, 100, "straight", args.crowd_duration)):
+            print(json.dumps(overhead(world, robots, controller, duration, args.repeat, tmp / "overhead.mcap")),
+                  flush=True)
         for robots in args.robots:
             world = tmp / f"robots_{robots}.world"
             world.write_text(world_text(robots, 240, 240.0, 5.6, seed=1))

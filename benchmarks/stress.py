@@ -10,6 +10,8 @@ Each check prints one JSON object per line (``"ok"`` says whether the guarantee 
   quiet run;
 * ``complete``: ``stage_sim run`` with N robots in lockstep recorded into a bag: every step of every robot is
   in it (steps recorded / steps simulated);
+* ``kill9``: ``stage_sim run rooms.world --speedup 1 --bag`` killed with SIGKILL after 5, 20 and 60 s of
+  real time, then ``stage_sim recover``: the sim seconds lost (about one: a chunk spans a sim second);
 * ``soak``: ``stageros`` at real time with a bag and the browser view open (a client reading its frames),
   under a ``cmd_vel`` flood and a storm of ``reset_positions`` calls: its sim rate per window and its
   memory (after a first window of warm-up), which must stay within 5 % of real time and flat.
@@ -58,10 +60,11 @@ class Sizes:
     complete_s: float  # its sim seconds
     soak_s: float  # wall seconds of the soak
     window_s: float  # wall seconds per rate sample of the soak
+    kill_after_s: tuple[float, ...]  # wall seconds of real-time recording before each kill -9
 
 
-FULL = Sizes(lockstep_s=300.0, robots=100, complete_s=600.0, soak_s=600.0, window_s=30.0)
-QUICK = Sizes(lockstep_s=20.0, robots=10, complete_s=20.0, soak_s=12.0, window_s=3.0)
+FULL = Sizes(lockstep_s=300.0, robots=100, complete_s=600.0, soak_s=600.0, window_s=30.0, kill_after_s=(5, 20, 60))
+QUICK = Sizes(lockstep_s=20.0, robots=10, complete_s=20.0, soak_s=12.0, window_s=3.0, kill_after_s=(3,))
 
 
 def bag_messages(path: Path) -> list[tuple[str, int, bytes]]:
@@ -158,6 +161,29 @@ def check_complete(sizes: Sizes, folder: Path) -> dict:
             "ok": result.returncode == 0 and recorded == steps and len(scans) == sizes.robots}
 
 
+def check_kill9(sizes: Sizes, folder: Path) -> dict:
+    """Sim seconds a kill -9 loses of a real-time recording: wall time since the bag appeared (the run starts
+    stepping right after creating it, so this slightly overcounts) minus the last /clock recovered."""
+    from stage_sim.bags.recover import recover
+
+    lost = {}
+    for after in sizes.kill_after_s:
+        bag = folder / f"killed_{after:g}.mcap"
+        process = subprocess.Popen([str(BIN / "stage_sim"), "run", "rooms.world", "--speedup", "1", "--bag", str(bag)],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        while not bag.exists():
+            time.sleep(0.005)
+        started = time.monotonic()
+        time.sleep(after)
+        process.kill()
+        ran = time.monotonic() - started
+        process.wait()
+        recover(bag, folder / f"recovered_{after:g}.mcap")
+        clocks = [t for topic, t, _ in bag_messages(folder / f"recovered_{after:g}.mcap") if topic == "/clock"]
+        lost[f"{after:g}"] = round(ran - (clocks[-1] / 1e9 if clocks else 0.0), 2)
+    return {"check": "kill9", "lost_sim_s_after_wall_s": lost, "ok": all(v <= 1.5 for v in lost.values())}
+
+
 def check_soak(sizes: Sizes, folder: Path) -> dict:
     """stageros at real time, recorded, viewed, flooded and reset; its rate and memory over time."""
     import rclpy
@@ -243,7 +269,8 @@ def _rss_mb(pid: int) -> float:
     return 0.0
 
 
-CHECKS = {"frozen": check_frozen, "concurrent": check_concurrent, "complete": check_complete, "soak": check_soak}
+CHECKS = {"frozen": check_frozen, "concurrent": check_concurrent, "complete": check_complete, "kill9": check_kill9,
+          "soak": check_soak}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -27,7 +27,7 @@ from rclpy.signals import SignalHandlerOptions
 from stage_sim.bags.errors import BagError
 from stage_sim.cli.arguments import add_duration_argument, add_seed_argument, add_speedup_argument
 from stage_sim.interface.names import numbered
-from stage_sim.interface.topics import ODOM, SCAN
+from stage_sim.interface.topics import CMD_VEL, ODOM, SCAN
 from stage_sim.ros.bag_recording import add_bag_arguments, bag_recording
 from stage_sim.ros.domain import use_private_domain
 from stage_sim.ros.recording import add_record_arguments, recording
@@ -57,8 +57,8 @@ class WanderSession:
         sim = self.stage.sim
         self.wanderers = []
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
-            first_scan = numbered(SCAN.name, len(robot.rangers))[0]
-            remap = ["--ros-args", "-r", f"{SCAN.name}:={first_scan}"] if robot.rangers else None
+            remap = (["--ros-args", "-r", f"{SCAN.name}:={numbered(SCAN.name, len(robot.rangers))[0]}"]
+                     if robot.rangers else None)
             overrides = [Parameter("holonomic", value=robot.drive.holonomic)]
             if seed is not None:
                 overrides.append(Parameter("seed", value=wanderer_seed(seed, index)))
@@ -117,6 +117,7 @@ class WanderSession:
         ControllerGone when a late robot's ``cmd_vel`` has no publisher left."""
         stage, sim = self.stage, self.stage.sim
         waiting = [i for i in range(len(self.wanderers)) if any(s.stamp == sim.sim_time for s in sim.scans[i])]
+        commands = [names.topic(CMD_VEL.name) for names in stage.names]
         started, warned = time.monotonic(), False
         while not stop.is_set():
             late = [i for i in waiting if sim.last_command_us[i] != sim.sim_time_us]
@@ -125,15 +126,15 @@ class WanderSession:
             self.executor.spin_once(timeout_sec=0.01)
             if time.monotonic() - started < LATE_ANSWER_S:
                 continue
-            gone = [i for i in late if stage.count_publishers(stage.names[i].cmd_vel) == 0]
+            gone = [i for i in late if stage.count_publishers(commands[i]) == 0]
             if gone:
-                raise ControllerGone(f"lockstep: nothing publishes {', '.join(stage.names[i].cmd_vel for i in gone)} "
-                                     f"any more (controller {', '.join(self.controller_names[i] for i in gone)})")
+                raise ControllerGone(f"lockstep: nothing publishes {', '.join(commands[i] for i in gone)} any more "
+                                     f"(controller {', '.join(self.controller_names[i] for i in gone)})")
             if not warned:
                 warned = True
                 stage.get_logger().warning(
                     f"lockstep: the step to sim time {sim.sim_time:g} s has waited {LATE_ANSWER_S:g} s for the "
-                    f"commands of {', '.join(stage.names[i].cmd_vel for i in late)} (nodes "
+                    f"commands of {', '.join(commands[i] for i in late)} (nodes "
                     f"{', '.join(self.controller_names[i] for i in late)}); still waiting")
 
 

@@ -49,14 +49,18 @@ def test_late_answers_give_the_same_run_and_are_reported_once(ros_context: Conte
 def test_a_controller_that_has_gone_ends_the_run_with_an_error(ros_context: Context, monkeypatch) -> None:
     monkeypatch.setattr(lockstep, "LATE_ANSWER_S", 0.2)
     session = WanderSession("rooms.world", 0.0, 11, duration=5.0, context=ros_context)
+    wanderer = session.wanderers[0]
+
+    def crash_after_three_steps() -> None:  # the controller process dies between two steps
+        if session.stage.sim.sim_time_us == 300_000:
+            session.executor.remove_node(wanderer)
+            wanderer.destroy_node()
+
+    session.stage.add_step_listener(crash_after_three_steps)
     try:
-        wanderer = session.wanderers[0]
-        session.executor.remove_node(wanderer)
-        wanderer.destroy_node()
-        stop = threading.Event()
         with pytest.raises(ControllerGone, match=r"nothing publishes cmd_vel any more \(controller wander_0\)"):
-            session.run(stop)
-        assert session.stage.sim.sim_time == pytest.approx(0.1)  # the first step's answer never came
+            session.run(threading.Event())
+        assert session.stage.sim.sim_time_us == 300_000  # no step without the answer
     finally:
-        session.wanderers.clear()
+        session.wanderers.remove(wanderer)  # already destroyed
         session.close()

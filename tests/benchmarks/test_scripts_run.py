@@ -1,0 +1,51 @@
+"""Every benchmark script runs: each is called with tiny sizes and must exit 0 with JSON lines on stdout, so
+none can rot between two `make bench` runs. Figures are not judged here (benchmarks prove speed, tests do
+not); the stress script's identity and completeness checks are, as they are guarantees, not speeds."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+BENCHMARKS = REPO / "benchmarks"
+CHROMIUM = Path("/usr/bin/chromium")
+
+TINY = {
+    "bags": ["--duration", "5", "--crowd-duration", "1", "--repeat", "1", "--robots", "1",
+             "--throughput-duration", "2"],
+    "envs": ["--seconds", "0.3", "--episodes", "0"],
+    "fidelity": ["--variants", "B"],
+    "jump_chain": [],
+    "raycast": [],
+    "simulate": ["--robots", "1", "2", "--seconds", "0.5"],
+    "stageros": ["--seconds", "1"],
+    "startup": ["--runs", "1"],
+    "stress": ["--quick", "--checks", "frozen", "complete", "kill9"],
+    "view": ["--seconds", "1", "--cases", "cpu"],
+    "wander_speed": ["--steps", "20"],
+    "wander_sweep": ["--core", "--seeds", "1", "--minutes", "0.2", "--jobs", "1"],
+    "worlds": ["--worlds", "floorplan", "rl", "--seconds", "0.1"],
+}
+
+
+def test_every_script_has_its_tiny_run() -> None:
+    assert {path.stem for path in BENCHMARKS.glob("*.py")} == set(TINY)
+
+
+@pytest.mark.parametrize("script", sorted(TINY))
+def test_the_script_runs_and_prints_json_lines(script: str) -> None:
+    if script == "view" and not CHROMIUM.exists():
+        pytest.skip(f"benchmarks/view.py drives Chromium: no Chromium at {CHROMIUM} (.ci/run installs it)")
+    result = subprocess.run([sys.executable, str(BENCHMARKS / f"{script}.py"), *TINY[script]], cwd=REPO,
+                            capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
+    assert result.returncode == 0, result.stderr[-3000:]
+    rows = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
+    assert rows, result.stdout[-2000:]
+    if script == "stress":
+        assert [row["check"] for row in rows] == ["frozen", "complete", "kill9"]
+        assert all(row["ok"] for row in rows), rows
