@@ -105,9 +105,9 @@ def test_a_table_without_its_data_fails_the_build(bench_data: Path, marker: str)
 
 def test_the_api_reference_has_a_page_per_package_in_layer_order() -> None:
     on_disk = {path.parent.name for path in (REPO / "stage_sim").glob("*/__init__.py")}
-    assert set(api.packages()) == on_disk
     layers = re.search(r"contract:layers\].*?layers =\n(.*?)\n\n", (REPO / ".importlinter").read_text(), re.DOTALL)
     order = [name.strip().removeprefix("stage_sim.") for line in layers[1].splitlines() for name in line.split("|")]
+    assert set(api.packages()) == on_disk | {"backend"}  # a layer that is one module
     assert [name for name in api.packages() if name in order] == order
     page = api.package_page("sim")
     assert "::: stage_sim.sim.simulation" in page and "::: stage_sim.sim\n" in page

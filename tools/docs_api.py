@@ -8,6 +8,7 @@ module, and the nav's "API reference" section gets one entry per package, in lay
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 from docs_rst_roles import ROLE, plain  # beside this hook: MkDocs puts a hook's folder on sys.path
@@ -16,17 +17,28 @@ from mkdocs.structure.files import File, Files
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "stage_sim"
-#: Layers top to bottom, as in stage_sim/__init__.py and .importlinter; a package not named here goes last.
-LAYER_ORDER = ("cli", "ros", "envs", "runs", "rendering", "view", "bags", "wander", "sim", "sensing", "maps",
-               "worldfile")
 SECTION = "API reference"
 
 
+def layer_order() -> list[str]:
+    """The layers top to bottom, read from .importlinter's layers contract (their one home)."""
+    block = re.search(r"contract:layers\].*?layers =\n(.*?)\n\n", (REPO / ".importlinter").read_text(), re.DOTALL)
+    return [name.strip().removeprefix("stage_sim.") for line in block[1].splitlines() for name in line.split("|")]
+
+
 def packages() -> list[str]:
-    """stage_sim's sub-packages on disk, in layer order."""
+    """stage_sim's sub-packages on disk and its top-level modules that are layers, in layer order (a package
+    not in the layers contract goes last)."""
+    layers = layer_order()
     found = [path.parent.name for path in PACKAGE.glob("*/__init__.py")]
-    rank = {name: index for index, name in enumerate(LAYER_ORDER)}
+    found += [path.stem for path in PACKAGE.glob("*.py") if path.stem in layers]
+    rank = {name: index for index, name in enumerate(layers)}
     return sorted(found, key=lambda name: (rank.get(name, len(rank)), name))
+
+
+def _source(package: str) -> Path:
+    folder = PACKAGE / package
+    return folder / "__init__.py" if folder.is_dir() else PACKAGE / f"{package}.py"
 
 
 def modules(package: str) -> list[str]:
@@ -38,7 +50,7 @@ def modules(package: str) -> list[str]:
 
 def summary(package: str) -> str:
     """The first line of the package's docstring: what the package holds."""
-    docstring = ast.get_docstring(ast.parse((PACKAGE / package / "__init__.py").read_text())) or ""
+    docstring = ast.get_docstring(ast.parse(_source(package).read_text())) or ""
     return ROLE.sub(plain, docstring.strip().splitlines()[0]) if docstring.strip() else ""
 
 

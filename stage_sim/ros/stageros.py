@@ -48,6 +48,11 @@ WARNING_THROTTLE_S = 5.0
 # re-adds to its wait set before every callback: with hundreds of per-robot endpoints that cost more than
 # the simulation step. Per-robot endpoints go without them; the world-wide ones keep the default warnings.
 NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
+# Timer wake-ups per step period. One, and a wake-up a little early (timer jitter) finds no step due and the
+# next steps one period late; a late node catching up with back-to-back callbacks (a guard condition) starved
+# the subscriptions, so commands waited while the watchdog stopped the robot. Two let it catch up a step per
+# half period, the executor's other work in between.
+WAKES_PER_STEP = 2
 NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
 
 
@@ -111,7 +116,6 @@ class StageRos(Node):
         self._step_listeners: list[Callable[[], None]] = []
         self.autostep = autostep
         self._timer = self._step_timer(autostep)
-        self._catch_up = self.create_guard_condition(self._step_due)
         self._publish_static()
         self.rivals = RivalPublishers(self, [topics.CLOCK.name], [
             t for n in self.names for t in (*topics.ODOM.names_on(n), *topics.SCAN.names_on(n)[:1])])
@@ -156,16 +160,16 @@ class StageRos(Node):
         super().destroy_node()
 
     def _step_timer(self, start: bool) -> Timer:
-        """The steady wall timer that wakes the node every step period (0: at every executor round)."""
-        return self.create_timer(
-            self.pacer.period, self._step_due, clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
+        """The steady wall timer that wakes the node WAKES_PER_STEP times per step period (0: at every executor
+        round): a node woken late catches up a step per wake-up, with the executor's other callbacks (commands,
+        which the watchdog counts in sim time) in between."""
+        return self.create_timer(self.pacer.period / WAKES_PER_STEP, self._step_due,
+                                 clock=Clock(clock_type=ClockType.STEADY_TIME), autostart=start)
 
     def _step_due(self) -> None:
-        """The steps the pacer says are due now; a node woken late comes back after the callbacks waiting."""
+        """The steps the pacer says are due now."""
         for _ in self.pacer.steps():
             self.step_once()
-        if self.pacer.behind():
-            self._catch_up.trigger()
 
     def _publish_static(self) -> None:
         """The latched topics, once: one /tf_static message with every robot's fixed frames (and /map if asked)."""

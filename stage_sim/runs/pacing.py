@@ -71,7 +71,7 @@ class Pacer:
 
     def steps(self) -> Iterator[None]:
         """Yield once per step to take now (the caller steps, then resumes the iteration). Paced, one step
-        if the schedule has reached it: a late loop catches up turn by turn (:meth:`behind`), with its host's
+        if the schedule has reached it: a late loop catches up turn by turn (:meth:`wait_s` says 0), with its host's
         work (commands above all, which the watchdog counts in sim time) in between; a schedule more than
         MAX_LAG_S behind starts afresh from now. With ``speedup <= 0`` steps back to back for FAST_BATCH_S of
         wall time, at least one. Nothing while paused or finished."""
@@ -91,11 +91,6 @@ class Pacer:
                 return
             taken += 1
             yield
-
-    def behind(self) -> bool:
-        """A paced run already owes its next step: its host should come back as soon as its other work is
-        done rather than wait for its next regular wake-up."""
-        return self.speedup > 0 and not (self.paused or self.finished()) and self.clock() >= self._due
 
     def wait_s(self) -> float:
         """Wall seconds until the next step is due: 0 now (and once finished: the caller's loop ends),
