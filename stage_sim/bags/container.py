@@ -6,9 +6,11 @@ as rosbag2 embeds it); one channel per topic (``cdr``) whose metadata holds ``of
 enums), written first so that a file cut short (kill -9) still says so after ``stage_sim recover``.
 
 Chunks are zstd-compressed and flushed to the operating system as soon as the library completes one, so
-after a kill -9 everything up to the last completed chunk is on disk. A chunk closes at CHUNK_BYTES or once it
-spans CHUNK_SIM_SECONDS of sim time, whichever comes first, so a kill -9 of a run at real time loses about a
-second; closing by sim time, not wall time, keeps a recording's bytes the same from run to run.
+after a kill -9 everything up to the last completed chunk is on disk. A recording paced to the wall clock
+also closes a chunk once it spans a wall second's worth of sim time (CHUNK_WALL_SECONDS × speedup), so a kill -9
+loses about a second of it; a run that is not paced closes chunks by size only (a chunk a sim second would cost
+it more than the writing, and its wall seconds hold many chunks anyway). Closing by sim time, not by the wall
+clock, keeps a recording's bytes the same from run to run.
 """
 
 from __future__ import annotations
@@ -25,9 +27,9 @@ from stage_sim.bags.topics import Topic, yaml_text
 
 CHUNK_BYTES = 1024 * 1024
 """Uncompressed bytes per chunk at most (the mcap and rosbag2 default)."""
-CHUNK_SIM_SECONDS = 1.0
-"""Sim seconds one chunk spans at most: what a kill -9 loses of a slow recording (one robot at real time fills
-a 1 MiB chunk in about 28 s)."""
+CHUNK_WALL_SECONDS = 1.0
+"""Wall seconds (at the run's speedup) one chunk of a paced recording spans at most: what a kill -9 loses of a
+slow recording (one robot at real time fills a 1 MiB chunk in about 28 s)."""
 PROFILE = "ros2"
 ROS_DISTRO = "jazzy"
 METADATA_VERSION = 9
@@ -58,8 +60,10 @@ def _rosbag2_metadata(path: Path) -> str:
 class McapBag:
     """An open bag: register the topics once, then :meth:`write` messages; :meth:`finish` writes the index."""
 
-    def __init__(self, path: Path, topics: list[Topic], typestore: Typestore, library: str) -> None:
-        """Create ``path`` (replacing a file there) and write everything but the messages.
+    def __init__(self, path: Path, topics: list[Topic], typestore: Typestore, library: str,
+                 speedup: float = 0.0) -> None:
+        """Create ``path`` (replacing a file there) and write everything but the messages; ``speedup`` is the
+        run's (``<= 0``: not paced, chunks close by size only).
 
         Raises BagError when the file cannot be created or written (missing folder, no permission, full disk)
         or does not end in .mcap."""
@@ -90,6 +94,7 @@ class McapBag:
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
         self._written = self._stream.tell()
         self._chunk_start_ns: int | None = None
+        self._chunk_span_ns = round(CHUNK_WALL_SECONDS * speedup * 1e9) if speedup > 0 else None
 
     def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
         """Add one message (log and publish time = its sim stamp); raises OSError when the disk refuses."""
@@ -98,9 +103,11 @@ class McapBag:
             self._stream.flush()
             self._written = self._stream.tell()
             self._chunk_start_ns = None
+        elif self._chunk_span_ns is None:
+            return
         elif self._chunk_start_ns is None:
             self._chunk_start_ns = log_time_ns
-        elif log_time_ns - self._chunk_start_ns >= CHUNK_SIM_SECONDS * 1e9:
+        elif log_time_ns - self._chunk_start_ns >= self._chunk_span_ns:
             self.flush()
 
     def flush(self) -> None:

@@ -4,7 +4,7 @@ After every step the stepping thread copies what the step published (:class:`Ste
 queue and goes on; a writer thread builds, serialises and writes the messages. When the queue is full (the
 writer, which shares the CPU with the simulation, or the disk cannot keep up):
 
-* a ``lossless`` recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
+* a lossless recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
   for the writer: the simulation slows down and every step is recorded;
 * a real-time recording drops the step rather than fall behind the wall clock: it is counted, the count is
   said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
@@ -69,20 +69,21 @@ class BagRecorder:
 
     def __init__(
         self, sim: Simulation, path: str | Path, names: list[RobotNames], *, namespace: str = "/",
-        topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim", lossless: bool = False,
+        topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim", speedup: float = 0.0,
     ) -> None:
         """Open the bag and write the latched messages (/tf_static, and /map when ``with_map``).
 
-        ``lossless``: :meth:`record_step` waits for room in the queue instead of dropping the step.
+        ``speedup``: the run's; ``<= 0`` (not paced) makes the recording lossless: :meth:`record_step` waits for
+        room in the queue instead of dropping the step.
         ``topics`` restricts the recording to those names (relative ones resolved in ``namespace``).
         Raises ValueError for an unknown topic and BagError when the file cannot be written."""
         self._sim = sim
         self._prog = prog
-        self.lossless = lossless
+        self.lossless = speedup <= 0
         self._names = names
         self.topics = select(stageros_topics(names, with_map, namespace), topics, namespace)
         self._builder = MessageBuilder(sim, names, self.topics)
-        self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY)
+        self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY, speedup)
         self.messages = self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
         self.summary: BagSummary | None = None

@@ -61,7 +61,7 @@ def _run(args: argparse.Namespace) -> int:
                  for r in sim.robots]
         try:
             recorder = BagRecorder(sim, args.bag, names, topics=args.bag_topics, with_map=args.map,
-                                   prog="stage_sim run", lossless=speedup <= 0)
+                                   prog="stage_sim run", speedup=speedup)
         except (BagError, ValueError) as exc:
             print(f"stage_sim run: {exc}", file=sys.stderr)
             return 2

@@ -47,7 +47,7 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
                            topics=args.bag_topics, with_map=stage.publish_map, prog=prog,
-                           lossless=stage.pacer.speedup <= 0)
+                           speedup=stage.pacer.speedup)
     stage.add_step_listener(recorder.record_step)
     try:
         yield recorder

@@ -1,1 +1,1 @@
-python benchmarks/bags.py --duration 60 --repeat 1
+python benchmarks/bags.py
