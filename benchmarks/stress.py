@@ -216,6 +216,7 @@ def check_soak(sizes: Sizes, folder: Path) -> dict:
         start = time.monotonic()
         window = (start, clock[-1])
         next_command = next_reset = start
+        warmed = False
         twist = Twist()
         twist.linear.x, twist.angular.z = 0.5, 0.3
         while (now := time.monotonic()) - start < sizes.soak_s:
@@ -227,9 +228,9 @@ def check_soak(sizes: Sizes, folder: Path) -> dict:
                 next_reset += 0.1
             executor.spin_once(timeout_sec=0.0005)
             if now - window[0] >= sizes.window_s:
-                windows.append((clock[-1] - window[1]) / (now - window[0]))
-                if len(windows) == 1:  # the first window is the warm-up (kernels loading, the view connecting)
-                    windows.clear()
+                if warmed:  # the first window is the warm-up (kernels loading, the view connecting)
+                    windows.append((clock[-1] - window[1]) / (now - window[0]))
+                warmed = True
                 memory.append(_rss_mb(process.pid))
                 window = (now, clock[-1])
     finally:
