@@ -43,9 +43,12 @@ def test_the_script_runs_and_prints_json_lines(script: str) -> None:
         pytest.skip(f"benchmarks/view.py drives Chromium: no Chromium at {CHROMIUM} (.ci/run installs it)")
     result = subprocess.run([sys.executable, str(BENCHMARKS / f"{script}.py"), *TINY[script]], cwd=REPO,
                             capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL)
-    assert result.returncode == 0, result.stderr[-3000:]
     rows = [json.loads(line) for line in result.stdout.splitlines() if line.startswith("{")]
-    assert rows, result.stdout[-2000:]
+    assert rows and "Traceback" not in result.stderr, result.stderr[-3000:]
+    # The sweep's exit status is its verdict on the wanderer (1: a seed fell short of its rule, as runs of a few
+    # sim seconds do), not a failure to run.
+    verdict = script == "wander_sweep" and result.returncode == 1 and rows[-1]["seeds_short"]
+    assert result.returncode == 0 or verdict, result.stderr[-3000:]
     if script == "stress":
         assert [row["check"] for row in rows] == ["frozen", "complete", "kill9"]
         assert all(row["ok"] for row in rows), rows
