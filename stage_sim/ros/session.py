@@ -40,11 +40,11 @@ from stage_sim.runs.stats import RunStats
 from stage_sim.worldfile.errors import WorldError
 
 LATE_ANSWER_S = 5.0  # wall seconds of waiting for a lockstep answer before saying which robots are late
+CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subscriptions to match
 
 
 class ControllerGone(RuntimeError):
     """A lockstep session waits for a controller that no longer publishes its robot's commands."""
-CONNECT_TIMEOUT_S = 10.0  # wall seconds for the in-process publishers and subscriptions to match
 
 
 class WanderSession:
