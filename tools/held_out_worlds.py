@@ -32,7 +32,8 @@ def main() -> None:
     rng = np.random.default_rng(args.seed)
     chosen = rng.permutation(len(starts))[: args.robots or len(starts)]
     headings = rng.uniform(-180.0, 180.0, chosen.size)
-    body = [f"bot( pose [{starts[i][0]} {starts[i][1]} {starts[i][2]} {a:.1f}] )" for i, a in zip(chosen, headings)]
+    body = [f"bot( pose [{starts[i][0]} {starts[i][1]} {starts[i][2]} {a:.1f}] )"
+            for i, a in zip(chosen, headings, strict=True)]
     sys.stdout.write("\n".join(head + body) + "\n")
 
 

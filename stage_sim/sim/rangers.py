@@ -122,8 +122,8 @@ class RangerSensing:
     def sense(self, poses: np.ndarray, time: float,
               body_cells: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``;
-        ``body_cells``: the robots' raster the rays see, (cell, robot) (:meth:`~stage_sim.sim.collision.Contact.raster`),
-        when the caller has it (else the bodies at ``poses``)."""
+        ``body_cells``: the robots' raster the rays see, (cell, robot)
+        (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
         due = ((now_us - self._last_us) >= self._interval_us) | self._stale
         self._stale = False

@@ -2,8 +2,9 @@
 
 A robot is a position model (stageros' rule: every position model, indexed in pre-order DFS). Its body is
 the polygons of every block in its subtree (the robot's own blocks and those of attached models such as
-the laser housing; bitmap bodies traced into blocks as Stage does, :mod:`stage_sim.maps.body_geometry`),
-expressed in the robot frame, rasterised at every pose as Stage does (:mod:`stage_sim.sim.collision`). Its rangers are its rangers by stageros' rule
+the laser housing; bitmap bodies traced into blocks as Stage does,
+:mod:`stage_sim.maps.body_geometry`), expressed in the robot frame, rasterised at every pose as Stage does
+(:mod:`stage_sim.sim.collision`). Its rangers are its rangers by stageros' rule
 (:func:`~stage_sim.worldfile.sensor_kinds.robot_sensors`: direct children only), one scan per ranger from its
 first sensor, as stageros publishes them.
 """
