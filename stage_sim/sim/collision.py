@@ -76,8 +76,8 @@ class Bodies:
     def next_vertex(self) -> np.ndarray:
         """Index of the vertex each edge ends at (V,): the next one of its polygon, the first after the last."""
         following = np.arange(1, len(self.vertices) + 1, dtype=np.int64)
-        last = self.poly_start[1:] - 1
-        following[last[last >= self.poly_start[:-1]]] = self.poly_start[:-1][last >= self.poly_start[:-1]]
+        filled = self.poly_start[1:] > self.poly_start[:-1]
+        following[self.poly_start[1:][filled] - 1] = self.poly_start[:-1][filled]
         return following
 
 
