@@ -29,7 +29,7 @@ from typing import Protocol
 import numpy as np
 
 from stage_sim.maps.polygon_raster import edge_cells_with_edges
-from stage_sim.maps.tiles import TileLayer
+from stage_sim.maps.tiles import TileLayer, unique_sorted
 from stage_sim.sim.kinematics import integrate
 
 
@@ -156,8 +156,8 @@ def shared_cells(cells: np.ndarray, owner: np.ndarray, other_cells: np.ndarray, 
     """For each robot of ``robots`` (ascending): the other robots whose cells (``other_*``) share a cell with
     its own (``cells``, ``owner``), as CSR (start per robot, robots); cells −1 ignored, repeats allowed."""
     n = np.int64(max(int(owner.max(initial=-1)), int(other_owner.max(initial=-1))) + 1)
-    a = np.unique(cells[cells >= 0] * n + owner[cells >= 0])
-    b = np.unique(other_cells[other_cells >= 0] * n + other_owner[other_cells >= 0])
+    a = unique_sorted(cells[cells >= 0] * n + owner[cells >= 0])
+    b = unique_sorted(other_cells[other_cells >= 0] * n + other_owner[other_cells >= 0])
     b_cell = b // n
     a_cell = a // n
     lo = np.searchsorted(b_cell, a_cell, side="left")
