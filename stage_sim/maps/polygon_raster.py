@@ -10,8 +10,11 @@ Cell (row r, col c) covers x ∈ [x0 + c·res, x0 + (c+1)·res), y ∈ [y0 + r·
   exist: the inside of a polygon is empty unless an edge runs through it.
 * **Filled footprints** (:func:`fill_cells`, :func:`fill_polygon`): cells whose centre is inside (even-odd
   rule) or that an edge passes through; what a map of the world shows, never what a ray sees.
-* **Sampled outlines** (:func:`outline_points`): points at most ``spacing`` apart along a moving body's
-  outline, cheap to move every step for thousands of robots.
+* **One polygon's walk** (:func:`edge_walk`): the same cells as :func:`edge_cells`, one polygon at a time in
+  plain loops that numba compiles, for the robot bodies rasterised again at every pose
+  (:mod:`stage_sim.sim.body_kernels`).
+* **Sampled outlines** (:func:`outline_points`): points at most ``spacing`` apart along an outline, for the
+  filled footprints.
 """
 
 from __future__ import annotations
@@ -41,11 +44,17 @@ def edge_cells(polygons: list[np.ndarray]) -> np.ndarray:
         return np.zeros((0, 2), dtype=np.int64)
     start = np.concatenate(polygons).astype(np.int64)
     end = np.concatenate([np.roll(p, -1, axis=0) for p in polygons]).astype(np.int64)
+    return edge_cells_with_edges(start, end)[0]
+
+
+def edge_cells_with_edges(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`edge_cells` of the edges ``start[e]`` → ``end[e]`` (E, 2) (vertex cells), with the edge of each
+    cell: the cells of edge 0 first, then edge 1's, … (as a robot body's cells are told from its owner)."""
     delta = end - start
     ax, ay = np.abs(delta[:, 0]), np.abs(delta[:, 1])
     steps = ax + ay
     if steps.sum() == 0:
-        return np.zeros((0, 2), dtype=np.int64)
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
     edge = np.repeat(np.arange(len(steps)), steps)
     first = np.cumsum(steps) - steps
     k = np.arange(edge.size) - first[edge]
@@ -61,7 +70,35 @@ def edge_cells(polygons: list[np.ndarray]) -> np.ndarray:
     x_before -= x_before[first[edge]]
     y_before -= y_before[first[edge]]
     direction = np.sign(delta)[edge]
-    return start[edge] + direction * np.stack([x_before, y_before], axis=1)
+    return start[edge] + direction * np.stack([x_before, y_before], axis=1), edge
+
+
+def edge_walk(vertices, out, k):
+    """Stage's ``World::MapPoly`` for one closed polygon of vertex cells (M, 2) (col, row): write the cells it
+    marks into ``out[k:]`` (room for the sum of |Δcol| + |Δrow| over its edges) and return the next free ``k``.
+
+    Cohen's walk as Stage writes it: error ``ay − ax``, an x-step while it is negative (+2·ay), else a y-step
+    (−2·ax), each cell marked before its step; the same cells, in the same order, as :func:`edge_cells`.
+    Plain loops on purpose: :mod:`stage_sim.sim.body_kernels` compiles this function with numba."""
+    m = vertices.shape[0]
+    for i in range(m):
+        x, y = vertices[i, 0], vertices[i, 1]
+        j = i + 1 if i + 1 < m else 0
+        dx, dy = vertices[j, 0] - x, vertices[j, 1] - y
+        sx = 1 if dx > 0 else (-1 if dx < 0 else 0)
+        sy = 1 if dy > 0 else (-1 if dy < 0 else 0)
+        ax, ay = abs(dx), abs(dy)
+        exy = ay - ax
+        for _ in range(ax + ay):
+            out[k, 0], out[k, 1] = x, y
+            k += 1
+            if exy < 0:
+                x += sx
+                exy += 2 * ay
+            else:
+                y += sy
+                exy -= 2 * ax
+    return k
 
 
 def fill_cells(

@@ -37,8 +37,8 @@ def number_robot_regions(regions, old, cells, ids, visible, place, width, marked
         cell = cells[i]
         if cell < 0:
             continue
-        if i > 0 and cell == cells[i - 1] and ids[i] == ids[i - 1]:  # the point before's cell (outlines are
-            tile[i], local[i] = tile[i - 1], local[i - 1]  # sampled at half a cell): nothing new to mark
+        if i > 0 and cell == cells[i - 1] and ids[i] == ids[i - 1]:  # the cell before's (a vertex shared by
+            tile[i], local[i] = tile[i - 1], local[i - 1]  # two edges, or two blocks): nothing new to mark
             continue
         r = np.int64(cell * per_width)  # cell // width without an integer division, corrected to be exact
         if r * width > cell:

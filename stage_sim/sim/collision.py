@@ -1,19 +1,24 @@
-"""Robot bodies on the grid: where their outlines fall, and which moves Stage would refuse.
+"""Robot bodies on the grid as Stage rasterises them, and which moves Stage refuses.
 
-A robot's body is a cloud of outline points in its own frame (see :mod:`stage_sim.sim.robots`).
-Placing all robots is one vectorised transform of all points; the cells they fall in are checked against
-the static collision layer (in tiles, :class:`~stage_sim.maps.tiles.TileLayer`) and against each other by
-the cells they share (sorted (cell, robot) pairs, or a hash table of the robots' cells in the compiled
-path: memory in proportion to the robots' cells, 16-32 B each, never to the world's area). The cells of
-every body at the accepted poses are kept up to date through the rounds of refusals (only the refused
-robots' cells change) and handed to the lasers, which see the robots through the same cells. A clash
-that a round leaves must involve a robot that round moved back (the others share the cells they had), so
-the next round looks only at robots within touching distance of those; the first round, only at robots
-within touching distance of another, and the compiled sweep looks at a body's points only where a region
-holding a wall cell lies within its radius (neither narrowing changes a refusal). As in Stage,
-a move that makes a body share a cell with an obstacle (a static cell with ``obstacle_return`` or another
-robot) is undone and the robot is marked stalled. Moves longer than half the body's width are checked at
-intermediate poses so that no speed the bounds allow can carry a body through a wall one cell thick.
+**Bodies.** A robot's body is its blocks' polygons in the robot frame (see :mod:`stage_sim.sim.robots`). At
+every pose each vertex is placed (``pose ⊕ vertex``, Stage's ``LocalToPixels``), floored to its world cell
+(``floor(x · ppm)``) and each edge walked cell by cell (``World::MapPoly``, the walk the static blocks take:
+:mod:`stage_sim.maps.polygon_raster`). Only edges exist, as in Stage. The casters and the contact test read
+the same raster.
+
+**Contacts** (Stage 4.3: ``World::Update``, ``ModelPosition::Move``, ``Block::TestCollision``). Stage keeps
+two raster layers and on update ``k`` works in layer ``k % 2``: robots with a non-zero velocity move one by
+one (Stage's order is its internal set order, by memory address; here robot index order, the closest
+deterministic rule); each is re-rasterised at its end pose (no sweep along the path) and tested against the
+static cells of its height band and the other obstacle robots' cells *in that layer*: those already moved
+in this update at their new pose, the others where that layer last saw them (two updates ago when they
+move every update). A refused move puts the robot back (re-rasterised there) and sets its stall flag; an
+accepted one clears it; a robot with zero velocity is not touched (it keeps its flag). Rays read the layer
+the moves just built (in Stage the sensors of update ``k + 1`` read layer ``k % 2``). The state is the
+pose of every robot in each layer (:attr:`Simulation._layer_poses`); this module is stateless.
+
+The numpy reference and the compiled backend (:mod:`stage_sim.sim.compiled`) share the decision order
+(:func:`decide_moves`, compiled there as it is) and differ in how the raster is computed, bit for bit the same.
 """
 
 from __future__ import annotations
@@ -23,18 +28,14 @@ from typing import Protocol
 
 import numpy as np
 
-from stage_sim.maps.polygon_raster import point_cells
+from stage_sim.maps.polygon_raster import edge_cells_with_edges
 from stage_sim.maps.tiles import TileLayer, unique_sorted
 from stage_sim.sim.kinematics import integrate
 
-# Robot-robot conflicts can cascade (a refused move leaves a robot where another one just moved); a few
-# rounds settle every realistic case, after which all robots still in conflict are refused together.
-MAX_CONFLICT_ROUNDS = 4
-# Robots refused in a round times colliding robots up to which the next round's clash test is narrowed to
-# the robots near the refused ones by a distance test (beyond, the test takes every colliding robot).
-NARROWING_PAIRS = 200_000
+
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """World coordinates of body points (P, 2), each given with the pose (P, 3) of its robot."""
+    """World coordinates of body points (P, 2), each given with the pose (P, 3) of its robot (Stage's
+    ``pose + Pose(x, y)``: x + px·cos − py·sin, y + px·sin + py·cos)."""
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     px, py = points[:, 0], points[:, 1]
     out = np.empty((len(poses), 2))  # filled column by column: np.stack costs more than this for a few points
@@ -45,22 +46,39 @@ def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Bodies:
-    """All robots' outline points, concatenated, with the robot each point belongs to."""
+    """All robots' body polygons in their robot frames, concatenated (robot r owns polygons
+    ``robot_poly[r]`` to ``robot_poly[r + 1]``, polygon p vertices ``poly_start[p]`` to ``poly_start[p + 1]``)."""
 
-    points: np.ndarray
-    owner: np.ndarray
+    vertices: np.ndarray  #: (V, 2) float64
+    poly_start: np.ndarray  #: (P + 1,) int64
+    robot_poly: np.ndarray  #: (R + 1,) int64
     count: int
-    min_width: np.ndarray
-    radius: np.ndarray
+    radius: np.ndarray  #: (R,) farthest vertex from the robot origin
 
     @classmethod
-    def from_outlines(cls, outlines: list[np.ndarray]) -> Bodies:
-        """Bodies from per-robot outline point arrays (each (P_i, 2) in the robot frame)."""
-        owner = np.concatenate([np.full(len(o), i, dtype=np.int64) for i, o in enumerate(outlines)] or [[]])
-        points = np.concatenate(outlines) if outlines else np.zeros((0, 2))
-        width = np.array([(o.max(axis=0) - o.min(axis=0)).min() if len(o) else 0.0 for o in outlines])
-        radius = np.array([np.hypot(*o.T).max() if len(o) else 0.0 for o in outlines])
-        return cls(points, owner.astype(np.int64), len(outlines), width, radius)
+    def from_polygons(cls, bodies: list[list[np.ndarray]]) -> Bodies:
+        """Bodies from per-robot lists of polygons (each (M, 2) in the robot frame)."""
+        polygons = [p for body in bodies for p in body]
+        vertices = np.concatenate(polygons).astype(np.float64) if polygons else np.zeros((0, 2))
+        sizes = [len(p) for p in polygons]
+        poly_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        robot_poly = np.concatenate([[0], np.cumsum([len(b) for b in bodies])]).astype(np.int64)
+        radius = np.array([max((np.hypot(*p.T).max() for p in body), default=0.0) for body in bodies])
+        return cls(vertices, poly_start, robot_poly, len(bodies), radius)
+
+    @property
+    def vertex_robot(self) -> np.ndarray:
+        """The robot of every vertex (V,)."""
+        per_poly = np.repeat(np.arange(self.count), np.diff(self.robot_poly))
+        return np.repeat(per_poly, np.diff(self.poly_start)).astype(np.int64)
+
+    @property
+    def next_vertex(self) -> np.ndarray:
+        """Index of the vertex each edge ends at (V,): the next one of its polygon, the first after the last."""
+        following = np.arange(1, len(self.vertices) + 1, dtype=np.int64)
+        filled = self.poly_start[1:] > self.poly_start[:-1]
+        following[self.poly_start[1:][filled] - 1] = self.poly_start[:-1][filled]
+        return following
 
 
 @dataclass(frozen=True)
@@ -72,31 +90,95 @@ class GridFrame:
     origin_xy: tuple[float, float]
     threads: int = 1  #: threads of the compiled loops over many items (the same answers for any)
 
+    @property
+    def corner(self) -> tuple[int, int]:
+        """World cell (col, row) of the grid's cell (0, 0) (the static raster's convention)."""
+        return round(self.origin_xy[0] / self.resolution), round(self.origin_xy[1] / self.resolution)
+
 
 class Contact(Protocol):
     """The contact role of a kernel backend (:mod:`stage_sim.sim.backends`): where the bodies lie, which moves
     are refused. :class:`CollisionChecker` is the numpy reference, and
     :class:`~stage_sim.sim.compiled.CompiledCollisionChecker` gives its answers bit for bit."""
 
-    def resolve(self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None,
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Move every robot by one step: (new poses, refused, every body point's cell at the new poses)."""
+    def resolve(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, dt: float,
+                moving: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """One update in the layer whose robots stand at ``layer_poses``: (new poses, refused, new layer poses)."""
         ...
 
     def overlapping(self, poses: np.ndarray) -> np.ndarray:
         """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
         ...
 
-    def point_cells(self, poses: np.ndarray) -> np.ndarray:
-        """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
+    def raster(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(flat cell, robot) of every body cell with the robots at ``poses`` (N, 3); cell −1 off the grid."""
         ...
+
+
+def decide_moves(testers, static_hit, before_start, before_other, cand_start, cand_other, back_start, back_other,
+                 refused):
+    """Stage's one-by-one moves: for the movers ``testers`` (ascending robot index), set ``refused[i]`` when the
+    end pose hits a static cell (``static_hit[i]``) or a cell of another obstacle robot as the layer holds it
+    when ``i`` moves. Per tester k, ``*_other[*_start[k]:*_start[k + 1]]`` are the robots sharing a cell with
+    its end pose: at their layer pose (``before``: valid for robots not moved yet in this update), at their
+    own end pose (``cand``: valid for earlier testers that moved) or back at their start pose (``back``:
+    earlier testers that were refused). Plain loops: :mod:`stage_sim.sim.body_kernels` compiles this."""
+    n = refused.size
+    tester = np.zeros(n, dtype=np.bool_)
+    for k in range(testers.size):
+        tester[testers[k]] = True
+    for k in range(testers.size):
+        i = testers[k]
+        hit = static_hit[i]
+        if not hit:
+            for m in range(before_start[k], before_start[k + 1]):
+                j = before_other[m]
+                if j > i or not tester[j]:
+                    hit = True
+                    break
+        if not hit:
+            for m in range(cand_start[k], cand_start[k + 1]):
+                j = cand_other[m]
+                if j < i and tester[j] and not refused[j]:
+                    hit = True
+                    break
+        if not hit:
+            for m in range(back_start[k], back_start[k + 1]):
+                j = back_other[m]
+                if j < i and tester[j] and refused[j]:
+                    hit = True
+                    break
+        refused[i] = hit
+
+
+def shared_cells(cells: np.ndarray, owner: np.ndarray, other_cells: np.ndarray, other_owner: np.ndarray,
+                 robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each robot of ``robots`` (ascending): the other robots whose cells (``other_*``) share a cell with
+    its own (``cells``, ``owner``), as CSR (start per robot, robots); cells −1 ignored, repeats allowed."""
+    n = np.int64(max(int(owner.max(initial=-1)), int(other_owner.max(initial=-1))) + 1)
+    a = unique_sorted(cells[cells >= 0] * n + owner[cells >= 0])
+    b = unique_sorted(other_cells[other_cells >= 0] * n + other_owner[other_cells >= 0])
+    b_cell = b // n
+    a_cell = a // n
+    lo = np.searchsorted(b_cell, a_cell, side="left")
+    hi = np.searchsorted(b_cell, a_cell, side="right")
+    counts = hi - lo
+    a_owner = np.repeat(a % n, counts)
+    first = np.repeat(lo - (np.cumsum(counts) - counts), counts)
+    b_owner = b[first + np.arange(counts.sum())] % n
+    keep = a_owner != b_owner
+    a_owner, b_owner = a_owner[keep], b_owner[keep]
+    order = np.argsort(a_owner, kind="stable")
+    a_owner, b_owner = a_owner[order], b_owner[order]
+    # every entry's robot is one of ``robots`` (the cells given are theirs): their slices follow each other
+    start = np.append(np.searchsorted(a_owner, robots, side="left"), a_owner.size).astype(np.int64)
+    return start, b_owner.astype(np.int64)
 
 
 class CollisionChecker:
     """Decides which robot moves to accept, given the static cells that block each robot's height band: the
-    numpy reference of the :class:`Contact` role. The compiled backend overrides its hooks, with the same
-    answers: ``_body_cells``, ``_moves``, ``_contains``, ``_replace_cells``, ``_close_to_another``, ``_close_to``
-    and ``_clashes``."""
+    numpy reference of the :class:`Contact` role. The compiled backend overrides ``_raster``, ``_contains``
+    and ``_decide`` with the same answers."""
 
     def __init__(
         self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
@@ -108,154 +190,85 @@ class CollisionChecker:
         self._layer_of_robot = layer_of_robot
         self._collides = collides
         self._robots_can_clash = int(np.count_nonzero(collides)) > 1
-        counts = np.bincount(bodies.owner, minlength=bodies.count)
-        self._point_count = counts
-        self._point_start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
         self._colliding = np.flatnonzero(collides)
+        self._everyone = np.arange(bodies.count, dtype=np.int64)
+        self._vertex_robot = bodies.vertex_robot
+        self._next_vertex = bodies.next_vertex
 
-    def resolve(
-        self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray | None = None
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Move every robot by one step; returns (new poses, refused, the cells of every body point at the new
-        poses, as :meth:`point_cells`) with refused moves undone.
-
-        Robots with zero velocity (``moving`` False, computed when not given) do not move and are never
-        refused here; the caller keeps their previous stall flag, as Stage does."""
-        moving = np.any(velocities != 0.0, axis=1) if moving is None else moving
+    def resolve(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, dt: float,
+                moving: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Move the ``moving`` robots one by one as Stage does, in the layer whose robots stand at
+        ``layer_poses``; returns (new poses, refused, the layer's new poses). Robots not moving are not
+        refused here: the caller keeps their stall flag, as Stage does."""
         refused = np.zeros(len(poses), dtype=bool)
-        movers = np.flatnonzero(moving & self._collides)
-        candidates = self._moves(poses, velocities, dt, moving, movers, refused)
+        candidates = poses.copy()
+        candidates[moving] = integrate(poses[moving], velocities[moving], dt)
+        testers = np.flatnonzero(moving & self._collides)
+        if testers.size:
+            cells, owner = self._raster(candidates, testers)
+            static_hit = self._static_hits(cells, owner)
+            if self._robots_can_clash:
+                others = self._colliding
+                before = self._raster(layer_poses, others)
+                back = self._raster(poses, testers)
+                self._decide(testers, static_hit, shared_cells(cells, owner, *before, testers),
+                             shared_cells(cells, owner, cells, owner, testers),
+                             shared_cells(cells, owner, *back, testers), refused)
+            else:
+                refused[testers] = static_hit[testers]
         final = np.where(refused[:, None], poses, candidates)
-        cells = self.point_cells(final)
-        if not self._robots_can_clash:
-            return final, refused, cells
-        among = self._crowded(final)
-        for _ in range(MAX_CONFLICT_ROUNDS):
-            conflict = self._clashes(cells, among) & moving & ~refused
-            if not conflict.any():
-                return final, refused, cells
-            refused |= conflict
-            final = np.where(refused[:, None], poses, candidates)
-            moved_back = np.flatnonzero(conflict)
-            self._replace_cells(cells, final, moved_back)
-            among = self._near(moved_back, final)
-        last = self._clashes(cells, among) & moving & ~refused
-        refused |= last
-        final = np.where(refused[:, None], poses, candidates)
-        self._replace_cells(cells, final, np.flatnonzero(last))
-        return final, refused, cells
+        layer = np.where(moving[:, None], final, layer_poses)
+        return final, refused, layer
 
     def overlapping(self, poses: np.ndarray) -> np.ndarray:
         """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
-        everyone = np.flatnonzero(self._collides)
+        everyone = self._colliding
         touching = np.zeros(len(poses), dtype=bool)
-        if everyone.size:
-            touching[everyone] = self._hits_static(poses, np.zeros_like(poses), 0.0, everyone)
-        if not self._robots_can_clash:
+        if not everyone.size:
             return touching
-        return touching | self._clashes(self.point_cells(poses), self._colliding)
+        cells, owner = self._raster(poses, everyone)
+        touching |= self._static_hits(cells, owner)
+        if self._robots_can_clash:
+            start, _ = shared_cells(cells, owner, cells, owner, everyone)
+            touching[everyone[np.diff(start) > 0]] = True
+        return touching
 
-    def point_cells(self, poses: np.ndarray) -> np.ndarray:
-        """Flat cell of every outline point with the robots at ``poses`` (N, 3); −1 outside the grid."""
-        return self._body_cells(self.bodies.points, self.bodies.owner, poses)
+    def raster(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(flat cell, robot) of every body cell with the robots at ``poses`` (N, 3); cell −1 off the grid."""
+        return self._raster(poses, self._everyone)
 
-    def _body_cells(self, points: np.ndarray, pose_index: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """Flat cell of body point i (robot frame) placed at pose ``poses[pose_index[i]]``; −1 off the grid."""
-        g = self.grid
-        return point_cells(place(points, poses[pose_index]), g.resolution, g.origin_xy, g.shape)
+    def _raster(self, poses: np.ndarray, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`raster` of ``robots`` (ascending) only, robot by robot, polygon by polygon, edge by edge."""
+        selected = np.zeros(self.bodies.count, dtype=bool)
+        selected[robots] = True
+        vi = np.flatnonzero(selected[self._vertex_robot])
+        position = np.empty(len(self._vertex_robot), dtype=np.int64)
+        position[vi] = np.arange(vi.size)
+        world = place(self.bodies.vertices[vi], poses[self._vertex_robot[vi]])
+        ppm = 1.0 / self.grid.resolution
+        start = np.floor(world * ppm).astype(np.int64)
+        end = start[position[self._next_vertex[vi]]]
+        cells, edge = edge_cells_with_edges(start, end)
+        col0, row0 = self.grid.corner
+        h, w = self.grid.shape
+        cols, rows = cells[:, 0] - col0, cells[:, 1] - row0
+        inside = (cols >= 0) & (cols < w) & (rows >= 0) & (rows < h)
+        return np.where(inside, rows * w + cols, -1), self._vertex_robot[vi][edge]
 
-    def _moves(
-        self, poses: np.ndarray, velocities: np.ndarray, dt: float, moving: np.ndarray, movers: np.ndarray,
-        refused: np.ndarray,
-    ) -> np.ndarray:
-        """The candidate poses of one step; marks in ``refused`` the movers whose sweep meets a static cell."""
-        candidates = poses.copy()
-        candidates[moving] = integrate(poses[moving], velocities[moving], dt)
-        if movers.size:
-            refused[movers] = self._hits_static(poses, velocities, dt, movers)
-        return candidates
-
-    def _points_of(self, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Indices of the outline points of each entry of ``robots`` and, per point, its entry number."""
-        counts = self._point_count[robots]
-        entry = np.repeat(np.arange(len(robots)), counts)
-        first = np.repeat(self._point_start[robots] - (np.cumsum(counts) - counts), counts)
-        return first + np.arange(counts.sum()), entry
-
-    def _hits_static(self, poses: np.ndarray, velocities: np.ndarray, dt: float, movers: np.ndarray) -> np.ndarray:
-        """Whether each mover's body meets a blocked cell at its new pose or at any intermediate pose."""
-        step = np.hypot(velocities[movers, 0], velocities[movers, 1]) * dt
-        sweep = step + np.abs(velocities[movers, 2]) * dt * self.bodies.radius[movers]
-        limit = np.maximum(self.bodies.min_width[movers] / 2, self.grid.resolution)
-        substeps = np.maximum(1, np.ceil(sweep / limit).astype(np.int64))
-        robot = np.repeat(movers, substeps)
-        fraction = (np.arange(len(robot)) - np.repeat(np.cumsum(substeps) - substeps, substeps) + 1) / np.repeat(
-            substeps, substeps)
-        probes = integrate(poses[robot], velocities[robot] * fraction[:, None], dt)
-        point_index, probe = self._points_of(robot)
-        cells = self._body_cells(self.bodies.points[point_index], probe, probes)
-        point_robot = robot[probe]
-        layer_index = self._layer_of_robot[point_robot]
+    def _static_hits(self, cells: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        """Per robot: whether one of its cells (``cells``, ``owner``) is a static cell of its height band."""
+        layer_index = self._layer_of_robot[owner]
         hit = np.zeros(len(cells), dtype=bool)
         for i, layer in enumerate(self._layers):
             use = (layer_index == i) & (cells >= 0)
             hit[use] = self._contains(layer, cells[use])
-        return (np.bincount(point_robot[hit], minlength=self.bodies.count) > 0)[movers]
+        return np.bincount(owner[hit], minlength=self.bodies.count) > 0
 
     def _contains(self, layer: TileLayer, cells: np.ndarray) -> np.ndarray:
         """Whether each flat cell is in the static layer."""
         return layer.contains(cells)
 
-    def _replace_cells(self, cells: np.ndarray, poses: np.ndarray, robots: np.ndarray) -> None:
-        """Put the cells of ``robots``' points (entries of :meth:`point_cells`) at ``poses`` into ``cells``."""
-        if not robots.size:
-            return
-        point_index, entry = self._points_of(robots)
-        cells[point_index] = self._body_cells(self.bodies.points[point_index], robots[entry], poses)
-
-    def _crowded(self, poses: np.ndarray) -> np.ndarray:
-        """The colliding robots within touching distance of another at ``poses`` (centres no farther apart than
-        their radii and two cells): only these can share a cell, so the first clash test looks at these alone;
-        every colliding robot when there are more than :data:`NARROWING_PAIRS` pairs to measure."""
-        robots = self._colliding
-        if robots.size * (robots.size - 1) // 2 > NARROWING_PAIRS:
-            return robots
-        return robots[self._close_to_another(robots, poses)]
-
-    def _close_to_another(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """Per robot of ``robots``: whether another of them is within touching distance at ``poses``."""
-        close = self._touching(robots, robots, poses)
-        np.fill_diagonal(close, False)
-        return close.any(axis=1)
-
-    def _near(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """The colliding robots whose bodies at ``poses`` could share a cell with one of ``robots``' (centres no
-        farther apart than their radii and two cells), ``robots`` included; all of them for many ``robots``."""
-        if robots.size * self._colliding.size > NARROWING_PAIRS:
-            return self._colliding
-        return self._colliding[self._close_to(robots, poses)]
-
-    def _close_to(self, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """Per colliding robot: whether one of ``robots`` is within touching distance at ``poses``."""
-        return self._touching(self._colliding, robots, poses).any(axis=1)
-
-    def _touching(self, others: np.ndarray, robots: np.ndarray, poses: np.ndarray) -> np.ndarray:
-        """(others, robots) pairs whose centres at ``poses`` are no farther apart than their radii and two cells
-        (the numpy path's distance matrix; the compiled one loops over the pairs)."""
-        gap = poses[others, None, :2] - poses[None, robots, :2]
-        reach = self.bodies.radius[others, None] + self.bodies.radius[None, robots] + 2 * self.grid.resolution
-        return np.hypot(gap[..., 0], gap[..., 1]) <= reach
-
-    def _clashes(self, cells: np.ndarray, among: np.ndarray) -> np.ndarray:
-        """Robots of ``among`` (colliding robots) whose body points (``cells``, per body point) share a cell
-        with another robot of ``among``."""
-        conflict = np.zeros(self.bodies.count, dtype=bool)
-        taking = np.zeros(self.bodies.count, dtype=bool)
-        taking[among] = True
-        keep = (cells >= 0) & taking[self.bodies.owner]
-        robots = np.int64(self.bodies.count)
-        pairs = unique_sorted(cells[keep] * robots + self.bodies.owner[keep])  # each (cell, robot) once, by cell
-        shared = pairs[1:] // robots == pairs[:-1] // robots
-        conflict[pairs[1:][shared] % robots] = True
-        conflict[pairs[:-1][shared] % robots] = True
-        return conflict
+    def _decide(self, testers: np.ndarray, static_hit: np.ndarray, before: tuple, cand: tuple, back: tuple,
+                refused: np.ndarray) -> None:
+        """:func:`decide_moves` (the compiled backend runs it compiled)."""
+        decide_moves(testers, static_hit, *before, *cand, *back, refused)

@@ -117,7 +117,8 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     backend.motion.warm(len(sim.robots))
     poses = sim.start_poses
     collision.overlapping(poses)
-    collision.resolve(poses, np.full_like(poses, 1e-3), 0.1)  # loads the sweep kernels (nothing is kept)
+    collision.resolve(poses, poses, np.full_like(poses, 1e-3), 0.1, np.ones(len(poses), dtype=bool))  # loads the
+    # raster and decision kernels (nothing is kept)
     sensing.sense(poses, 0.0)
     note_kernels_running(backend.name)
     return CompiledParts(collision, sensing, backend)

@@ -59,14 +59,14 @@ class RangerSensing:
 
     def __init__(
         self, robots: list[RobotSpec], static: StaticRaster, bodies: Bodies, grid: GridFrame, backend: Backend,
-        point_cells: Callable[[np.ndarray], np.ndarray],
+        raster: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
     ) -> None:
-        """``backend``: the kernels the rays are cast and their returns looked up with; ``point_cells``: the
-        cells of the robots' bodies at given poses (:meth:`~stage_sim.sim.collision.Contact.point_cells`)."""
+        """``backend``: the kernels the rays are cast and their returns looked up with; ``raster``: the
+        cells of the robots' bodies at given poses (:meth:`~stage_sim.sim.collision.Contact.raster`)."""
         self._bodies = bodies
         self._grid = grid
         self._backend = backend
-        self._point_cells = point_cells
+        self._raster = raster
         self._rangers = [(robot.index, ranger) for robot in robots for ranger in robot.rangers]
         owners, angles, ranges, heights, ranger_of_ray = [], [], [], [], []
         for k, (robot_index, ranger) in enumerate(self._rangers):
@@ -119,10 +119,11 @@ class RangerSensing:
         """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
         self._stale = True
 
-    def sense(self, poses: np.ndarray, time: float, body_cells: np.ndarray | None = None) -> None:
+    def sense(self, poses: np.ndarray, time: float,
+              body_cells: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         """Cast the rangers that are due at ``time`` (all of them after :meth:`invalidate`) from ``poses``;
-        ``body_cells``: the robots' cells at ``poses`` when the caller has them
-        (:meth:`~stage_sim.sim.collision.Contact.point_cells`)."""
+        ``body_cells``: the robots' raster the rays see, (cell, robot)
+        (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
         due = ((now_us - self._last_us) >= self._interval_us) | self._stale
         self._stale = False
@@ -136,7 +137,7 @@ class RangerSensing:
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
         robot_cells = None
         if self._bodies.count:
-            robot_cells = self._point_cells(poses) if body_cells is None else body_cells
+            robot_cells = self._raster(poses) if body_cells is None else body_cells
         jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
         origins = place(self._ranger_offset, poses[self._ranger_owner])
         for group in self._groups:
@@ -157,7 +158,8 @@ class RangerSensing:
 
     def _cast(
         self, group: _HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
-        jitter: np.ndarray | None, robot_cells: np.ndarray | None, ranges: np.ndarray, intensity: np.ndarray,
+        jitter: np.ndarray | None, robot_cells: tuple[np.ndarray, np.ndarray] | None, ranges: np.ndarray,
+        intensity: np.ndarray,
     ) -> None:
         """Cast the group's rays (those at ``chosen`` positions of it; all when None) from the rangers'
         ``origins`` and write their ranges and intensities."""
@@ -168,9 +170,9 @@ class RangerSensing:
         layer = None
         if robot_cells is not None:
             if self._bodies.count > 1:
-                group.robots.update_flat(robot_cells, self._bodies.owner, group.robot_visible)
+                group.robots.update_flat(*robot_cells, group.robot_visible)
             else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
-                group.robots.mark_flat(robot_cells)
+                group.robots.mark_flat(robot_cells[0])
             layer = group.robots
         cell, hit_robot = group.caster.cast_into(
             origins, ranger, poses[self._ranger_owner, 2], angle, max_range, owner, layer, rays, ranges,

@@ -1,8 +1,10 @@
 """What the simulation needs to know about each robot and each of its lasers, read once from the world.
 
 A robot is a position model (stageros' rule: every position model, indexed in pre-order DFS). Its body is
-the outline of every block in its subtree (the robot's own blocks and those of attached models such as
-the laser housing), expressed in the robot frame. Its rangers are its rangers by stageros' rule
+the polygons of every block in its subtree (the robot's own blocks and those of attached models such as
+the laser housing; bitmap bodies traced into blocks as Stage does,
+:mod:`stage_sim.maps.body_geometry`), expressed in the robot frame, rasterised at every pose as Stage does
+(:mod:`stage_sim.sim.collision`). Its rangers are its rangers by stageros' rule
 (:func:`~stage_sim.worldfile.sensor_kinds.robot_sensors`: direct children only), one scan per ranger from its
 first sensor, as stageros publishes them.
 """
@@ -15,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from stage_sim.maps.body_geometry import body_polygons, global_poses, transform_points
-from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.drives import DRIVES, Drive
 from stage_sim.worldfile.description import Model, Pose, PositionSettings, Sensor, WorldDescription, WorldWarning
 from stage_sim.worldfile.errors import SourceLocation
@@ -54,7 +55,7 @@ class RobotSpec:
     start: tuple[float, float, float]
     settings: PositionSettings
     z_band: tuple[float, float]
-    outline: np.ndarray
+    body: tuple[np.ndarray, ...]  #: polygons (M, 2) in the robot frame
     rangers: tuple[RangerSpec, ...]
 
     @property
@@ -64,30 +65,22 @@ class RobotSpec:
 
     @property
     def radius(self) -> float:
-        """Distance from the robot origin to the farthest outline point (bounds rotation sweeps)."""
-        return float(np.hypot(*self.outline.T).max()) if len(self.outline) else 0.0
-
-    @property
-    def min_width(self) -> float:
-        """Smallest side of the outline's bounding box: the body cannot tunnel through less than this."""
-        if len(self.outline) == 0:
-            return 0.0
-        return float((self.outline.max(axis=0) - self.outline.min(axis=0)).min())
+        """Distance from the robot origin to the farthest body vertex (the body's reach as it turns)."""
+        return max((float(np.hypot(*p.T).max()) for p in self.body if len(p)), default=0.0)
 
 
 def build_robots(description: WorldDescription, warnings: list[WorldWarning]) -> list[RobotSpec]:
     """Every position model of the world as a :class:`RobotSpec`, in stageros' robot order."""
     poses = global_poses(description)
-    spacing = description.settings.resolution / 2
     robots = []
     several: dict[SourceLocation | None, list[str]] = {}  # rangers with several sensors, by where they are defined
     for index, model in enumerate(description.robots()):
         pose = poses[id(model)]
-        outline, z_band = _body_outline(model, pose, poses, spacing)
+        body, z_band = _body(model, pose, poses)
         rangers = tuple(_rangers(model, pose, poses, several))
         settings = model.position or PositionSettings()
         robots.append(
-            RobotSpec(index, model.name, model, (pose.x, pose.y, pose.yaw), settings, z_band, outline, rangers)
+            RobotSpec(index, model.name, model, (pose.x, pose.y, pose.yaw), settings, z_band, body, rangers)
         )
     # One warning per definition, not per robot: a swarm of a thousand must not bury the log.
     for location, messages in several.items():
@@ -96,20 +89,24 @@ def build_robots(description: WorldDescription, warnings: list[WorldWarning]) ->
     return robots
 
 
-def _body_outline(
-    robot: Model, robot_pose: Pose, poses: dict[int, Pose], spacing: float
-) -> tuple[np.ndarray, tuple[float, float]]:
-    """Outline points of all bodies in the robot's subtree, in the robot frame, and their joint z band."""
-    points, z_low, z_high = [], math.inf, -math.inf
+def _body(
+    robot: Model, robot_pose: Pose, poses: dict[int, Pose]
+) -> tuple[tuple[np.ndarray, ...], tuple[float, float]]:
+    """Polygons of all bodies in the robot's subtree, in the robot frame, and their joint z band.
+
+    The robot's own polygons are its model-frame ones (``origin`` applied); an attached model's are moved by
+    its pose relative to the robot, in one composition where Stage makes two (it may differ by a cell)."""
+    polygons, z_low, z_high = [], math.inf, -math.inf
     for model in robot.walk():
         relative = _relative(robot_pose, poses[id(model)])
         for polygon in body_polygons(model):
-            points.append(transform_points(outline_points(polygon.points, spacing), relative))
+            points = polygon.points if model is robot else transform_points(polygon.points, relative)
+            polygons.append(np.asarray(points, dtype=np.float64))
             z_low = min(z_low, relative.z + polygon.z[0])
             z_high = max(z_high, relative.z + polygon.z[1])
-    if not points:
-        return np.zeros((0, 2)), (0.0, 0.0)
-    return np.concatenate(points), (robot_pose.z + z_low, robot_pose.z + z_high)
+    if not polygons:
+        return (), (0.0, 0.0)
+    return tuple(polygons), (robot_pose.z + z_low, robot_pose.z + z_high)
 
 
 def _relative(base: Pose, pose: Pose) -> Pose:

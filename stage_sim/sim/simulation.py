@@ -1,9 +1,10 @@
 """The ROS-free simulation: a Stage world stepped at ``interval_sim``, deterministic for a seed.
 
 One :meth:`Simulation.step` advances sim time by one ``interval_sim`` and, in this order: applies the
-watchdog, turns commands into body velocities (drive + ``velocity_bounds``), moves every robot (refusing
-moves into obstacles: the robot stalls), updates odometry, and casts every due laser from the *new* poses,
-so scans and odometry agree with the ground truth of the same stamp (Stage lags one step; we do not).
+watchdog, turns commands into body velocities (drive + ``velocity_bounds``), moves the robots one by one as
+Stage does (refusing moves into obstacles: the robot stalls; Stage's two raster layers, see
+:mod:`stage_sim.sim.collision`), updates odometry, and casts every due laser from the *new* poses, so scans
+and odometry agree with the ground truth of the same stamp (Stage lags one step; we do not).
 
 Usage::
 
@@ -68,7 +69,7 @@ class Simulation:
         self.watchdog_timeout = watchdog_timeout
         starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
         self.static: StaticRaster = build_static_raster(description, starts)
-        self._bodies = Bodies.from_outlines([r.outline for r in self.robots])
+        self._bodies = Bodies.from_polygons([list(r.body) for r in self.robots])
         self._collision, self._sensing = self.build_parts(self.kernels)
         self._motion = backend_for(self.kernels).motion
         note_kernels_running(self.kernels)
@@ -105,6 +106,7 @@ class Simulation:
         """Back to the start: time 0, start poses, no motion, fresh scans; a new seed redraws the random parts."""
         self.rng = np.random.default_rng(seed)
         self.sim_time_us = 0
+        self._updates = 0  # Stage's update count: its parity picks the raster layer the moves work in
         self.odom_errors = draw_odom_errors([r.settings.odom_error for r in self.robots], self.rng)
         self._sensing.reset(self.rng)
         self.reset_positions()
@@ -120,6 +122,7 @@ class Simulation:
         self.commands = np.zeros((n, 3))
         self.velocities = np.zeros((n, 3))
         self.stalled = np.zeros(n, dtype=bool)
+        self._layer_poses = np.stack([self._start, self._start])  # where each of Stage's two layers has them
         self.last_command_us = np.full(n, self.sim_time_us, dtype=np.int64)
         self.odometry_poses = np.where(
             self._uses_odom[:, None], relative_pose(self._start, self._odom_origin), self._start)
@@ -145,6 +148,8 @@ class Simulation:
         self.true_poses = self.true_poses.copy()
         self.true_poses[robot] = (x, y, float(np.remainder(yaw + np.pi, 2 * np.pi) - np.pi))
         self.stalled[robot] = False
+        self._layer_poses = self._layer_poses.copy()
+        self._layer_poses[:, robot] = self.true_poses[robot]  # Stage's SetPose maps both layers
         self.odometry_poses = np.where(self._uses_odom[:, None], self.odometry_poses, self.true_poses)
         self._sensing.invalidate()
 
@@ -159,11 +164,17 @@ class Simulation:
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
         moving = np.any(self.velocities != 0.0, axis=1)
-        moved, refused, body_cells = self._collision.resolve(self.true_poses, self.velocities, dt, moving)
+        layer = self._updates % 2
+        moved, refused, layer_poses = self._collision.resolve(
+            self.true_poses, self._layer_poses[layer], self.velocities, dt, moving)
+        self._layer_poses = self._layer_poses.copy()
+        self._layer_poses[layer] = layer_poses
+        self._updates += 1
         self.stalled = np.where(moving, refused, self.stalled)
         self.true_poses = moved
         self.odometry_poses = self._odometry(moved, dt)
-        self._sensing.sense(self.true_poses, self.sim_time, body_cells)
+        # The rays read the layer just built (Stage's sensors of the next update read it), not the true poses.
+        self._sensing.sense(self.true_poses, self.sim_time, self._collision.raster(layer_poses))
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
 
@@ -233,7 +244,7 @@ class Simulation:
         backend = backend_for(kernels)
         grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.threads)
         collision = self._make_collision_checker(backend, grid)
-        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, backend, collision.point_cells)
+        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, backend, collision.raster)
         return collision, sensing
 
     def _make_collision_checker(self, backend: Backend, grid: GridFrame) -> Contact:

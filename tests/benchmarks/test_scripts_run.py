@@ -19,7 +19,7 @@ TINY = {
     "bags": ["--duration", "5", "--crowd-duration", "1", "--repeat", "1", "--robots", "1",
              "--throughput-duration", "2"],
     "envs": ["--seconds", "0.3", "--episodes", "0"],
-    "fidelity": ["--variants", "B"],
+    "fidelity": ["--variants", "B", "--robot-worlds", "crowd_100", "--robot-seconds", "1"],
     "jump_chain": [],
     "raycast": [],
     "simulate": ["--robots", "1", "2", "--seconds", "0.5"],

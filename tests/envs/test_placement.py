@@ -13,6 +13,7 @@ from stage_sim.envs import RobotBody
 from stage_sim.envs.free_space import PlacementError
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
+from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.simulation import Simulation
 
 SEEDS = 1000
@@ -22,7 +23,8 @@ YAWS = np.linspace(-math.pi, math.pi, 16, endpoint=False)
 
 def footprint_cells(sim: Simulation, robot: int, x: float, y: float, yaws: np.ndarray) -> np.ndarray:
     """Flat cells under the robot's outline at (x, y) for each yaw, and under its centre."""
-    outline = sim.robots[robot].outline
+    spacing = sim.static.resolution / 2
+    outline = np.concatenate([outline_points(p, spacing) for p in sim.robots[robot].body])
     points = [np.array([[x, y]])]
     for yaw in yaws:
         c, s = math.cos(yaw), math.sin(yaw)

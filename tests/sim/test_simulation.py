@@ -124,17 +124,6 @@ def test_stall_against_another_robot() -> None:
     assert sim.true_poses[1] == pytest.approx([2.7, 2.0, 0.0])
 
 
-def test_no_tunnelling_through_a_one_cell_wall_at_maximum_speed() -> None:
-    fast = 'velocity_bounds [-20 20 -20 20 -1 1 -90 90]'
-    thin = 'wall( name "thin" size [0.02 10 1] pose [5.01 5 0 0] )\n'
-    sim = sim_of('bot( pose [4 5 0 0] )', extra=fast, more=thin)
-    sim.set_velocity(0, 20.0, 0.0, 0.0)  # 2 m per step: five body lengths
-    for _ in range(5):
-        sim.step()
-        assert sim.true_poses[0][0] < 5.0
-    assert sim.stalled[0]
-
-
 def test_reset_positions_restores_start_and_clears_state() -> None:
     sim = sim_of('bot( pose [9.5 5 0 0] )', extra='localization "odom" odom_error [0 0 0 0]')
     sim.set_velocity(0, 1.0, 0.0, 0.3)
