@@ -131,6 +131,8 @@ class McapBag:
             self._channels[topic.name] = foxglove.Channel(topic.name, schema=schemas[topic.msgtype],
                                                           message_encoding="cdr", context=self._context,
                                                           metadata=metadata)
+        # The channels' own log(data, log_time), without the wrapper's checks for JSON and str messages.
+        self._log = {name: channel.base.log for name, channel in self._channels.items()}
         self._chunk_start_ns: int | None = None
         self._chunk_span_ns = round(CHUNK_WALL_SECONDS * speedup * 1e9) if speedup > 0 else None
 
@@ -145,7 +147,7 @@ class McapBag:
 
     def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
         """Add one message (log and publish time = its sim stamp); raises OSError when the disk refuses."""
-        self._channels[topic].log(data, log_time=log_time_ns)
+        self._log[topic](data, log_time_ns)
         if self._file.error is not None:  # the library only logs a failed write of a chunk
             raise self._file.error
         if self._chunk_span_ns is None:

@@ -26,8 +26,11 @@ from stage_sim.interface.topics import Endpoint
 HEADER = 4
 """Bytes of the CDR encapsulation header: alignment counts from here."""
 _STAMP = struct.Struct("<iI")
-_TWO = struct.Struct("<dd")
 _COUNT = struct.Struct("<I")
+_POSE = struct.Struct("<dd24xdd")
+"""Position x, y, (z; orientation x, y: always 0), orientation z, w."""
+_TWIST = struct.Struct("<dd24xd")
+"""Linear x, y, (linear z; angular x, y: always 0), angular z."""
 
 
 def _aligned(offset: int, size: int) -> int:
@@ -56,6 +59,12 @@ class Layout(ABC):
     def __init__(self, template: bytes) -> None:
         self._buffer = bytearray(template)
 
+    @staticmethod
+    def prepare(values: Any) -> Any:
+        """A step's values as :meth:`refill` reads them, once per step for all endpoints (arrays as lists:
+        reading Python floats is cheaper than numpy scalars)."""
+        return values
+
     @abstractmethod
     def refill(self, values: Any, endpoint: Endpoint, sim_time_us: int) -> bytes | None:
         """The message's bytes for this step's ``values`` (the topic's :attr:`Topic.values`), None for none."""
@@ -72,7 +81,9 @@ class ClockLayout(Layout):
 class BoolLayout(Layout):
     """std_msgs/Bool of a robot (stall): one byte."""
 
-    def refill(self, values: np.ndarray, endpoint: Endpoint, sim_time_us: int) -> bytes:
+    prepare = staticmethod(np.ndarray.tolist)
+
+    def refill(self, values: list[bool], endpoint: Endpoint, sim_time_us: int) -> bytes:
         self._buffer[HEADER] = bool(values[endpoint.robot])
         return bytes(self._buffer)
 
@@ -82,21 +93,20 @@ class OdometryLayout(Layout):
 
     def __init__(self, template: bytes) -> None:
         super().__init__(template)
-        pose = _aligned(_after_string(template, _after_header(template, HEADER)), 8)
-        self._position, self._orientation = pose, pose + 5 * 8  # position x, y; orientation z, w
-        twist = pose + (7 + 36) * 8  # after the pose and its covariance
-        self._linear, self._angular = twist, twist + 5 * 8
+        self._pose = _aligned(_after_string(template, _after_header(template, HEADER)), 8)
+        self._twist = self._pose + (7 + 36) * 8  # after the pose and its covariance
 
-    def refill(self, values: tuple[np.ndarray, np.ndarray], endpoint: Endpoint, sim_time_us: int) -> bytes:
-        poses, velocities = values
-        x, y, yaw = poses[endpoint.robot]
-        vx, vy, vyaw = velocities[endpoint.robot]
+    @staticmethod
+    def prepare(values: tuple[np.ndarray, np.ndarray]) -> tuple[list, list]:
+        return values[0].tolist(), values[1].tolist()
+
+    def refill(self, values: tuple[list, list], endpoint: Endpoint, sim_time_us: int) -> bytes:
+        x, y, yaw = values[0][endpoint.robot]
+        vx, vy, vyaw = values[1][endpoint.robot]
         buffer = self._buffer
         _stamp(buffer, HEADER, sim_time_us)
-        _TWO.pack_into(buffer, self._position, x, y)
-        _TWO.pack_into(buffer, self._orientation, *fields.yaw_quaternion(float(yaw))[2:])
-        _TWO.pack_into(buffer, self._linear, vx, vy)
-        struct.pack_into("<d", buffer, self._angular, vyaw)
+        _POSE.pack_into(buffer, self._pose, x, y, *fields.yaw_quaternion(yaw)[2:])
+        _TWIST.pack_into(buffer, self._twist, vx, vy, vyaw)
         return bytes(buffer)
 
 
@@ -133,11 +143,12 @@ class TransformsLayout(Layout):
             self._translations.append(translation)
             offset = translation + 7 * 8
 
-    def refill(self, values: np.ndarray, endpoint: Endpoint, sim_time_us: int) -> bytes:
+    prepare = staticmethod(np.ndarray.tolist)
+
+    def refill(self, values: list[list[float]], endpoint: Endpoint, sim_time_us: int) -> bytes:
         buffer = self._buffer
-        stamp = fields.stamp_parts(sim_time_us)
-        for at, translation, (x, y, yaw) in zip(self._stamps, self._translations, values.tolist(), strict=True):
-            _STAMP.pack_into(buffer, at, *stamp)
-            _TWO.pack_into(buffer, translation, x, y)
-            _TWO.pack_into(buffer, translation + 5 * 8, *fields.yaw_quaternion(yaw)[2:])
+        sec, nanosec = fields.stamp_parts(sim_time_us)
+        for at, translation, (x, y, yaw) in zip(self._stamps, self._translations, values, strict=True):
+            _STAMP.pack_into(buffer, at, sec, nanosec)
+            _POSE.pack_into(buffer, translation, x, y, *fields.yaw_quaternion(yaw)[2:])
         return bytes(buffer)

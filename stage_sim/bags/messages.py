@@ -254,7 +254,7 @@ class MessageBuilder:
         log_time = fields.stamp_ns(sim_time_us)
         for channel in self._channels:
             if channel.topic.timing is not Timing.START:
-                values = state.values[channel.topic]
+                values = LAYOUTS[channel.topic].prepare(state.values[channel.topic])
                 for name, layout, endpoint in channel.outlets:
                     data = layout.refill(values, endpoint, sim_time_us)
                     if data is not None:

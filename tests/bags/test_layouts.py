@@ -33,9 +33,10 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic) -> None:
     for _ in range(12):
         sim.step()
         values = StepState.capture(sim, names, [topic]).values[topic]
+        prepared = LAYOUTS[topic].prepare(values)
         for endpoint, layout, msg in zip(endpoints, layouts, messages, strict=True):
             filled = TOPIC_MESSAGES[topic].fill(msg, values, endpoint, _time(sim.sim_time_us))
-            refilled = layout.refill(values, endpoint, sim.sim_time_us)
+            refilled = layout.refill(prepared, endpoint, sim.sim_time_us)
             if filled is None:
                 assert refilled is None
                 continue
