@@ -14,7 +14,7 @@ bytes (:mod:`stage_sim.bags.layouts`), which costs a fraction of a serialisation
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -59,13 +59,14 @@ class StepState:
     """What one step publishes, copied off the simulation so the writer thread can build it later."""
 
     sim_time_us: int
-    values: dict[Topic, Any]
-    """The values of every per-step topic (:attr:`Topic.values`)."""
+    values: list[Any]
+    """The values (:attr:`Topic.values`) of the per-step topics it was captured for, in their order (a list,
+    not a dict by topic: hashing a Topic, a dataclass of enums, every step cost more than the copies)."""
 
     @classmethod
     def capture(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> StepState:
         """Copy the state of the step just taken (cheap: small arrays and references to the fresh scans)."""
-        return cls(sim.sim_time_us, {topic: _owned(topic.values(sim, names)) for topic in stepped})
+        return cls(sim.sim_time_us, [_owned(topic.values(sim, names)) for topic in stepped])
 
 
 def _time(sim_time_us: int) -> object:
@@ -216,6 +217,8 @@ class _Channel:
 
     topic: Topic
     outlets: list[tuple[str, Any, Endpoint]]
+    prepare: Callable[[Any], Any] | None = None
+    """The per-step topics' :meth:`Layout.prepare`."""
 
 
 class MessageBuilder:
@@ -231,11 +234,13 @@ class MessageBuilder:
                 continue
             if topic.timing is Timing.START:
                 outlets = [(name, TOPIC_MESSAGES[topic].build(e, sim, names), e) for name, e in endpoints]
+                self._channels.append(_Channel(topic, outlets))
             else:
                 outlets = [(name, LAYOUTS[topic](template(topic, e, sim, names)), e) for name, e in endpoints]
-            self._channels.append(_Channel(topic, outlets))
-        self.stepped = [c.topic for c in self._channels if c.topic.timing is not Timing.START]
-        """The recorded topics published every step: what :meth:`StepState.capture` takes."""
+                self._channels.append(_Channel(topic, outlets, LAYOUTS[topic].prepare))
+        self._stepped = [c for c in self._channels if c.topic.timing is not Timing.START]
+        self.stepped = [c.topic for c in self._stepped]
+        """The recorded topics published every step: what :meth:`StepState.capture` takes, in this order."""
 
     def static(self, sim: Simulation) -> Iterator[tuple[str, int, bytes]]:
         """The latched messages stageros sends once at start: /tf_static, and /map when recorded."""
@@ -252,21 +257,19 @@ class MessageBuilder:
         """Everything one step publishes on the recorded topics, in stageros' publishing order."""
         sim_time_us = state.sim_time_us
         log_time = fields.stamp_ns(sim_time_us)
-        for channel in self._channels:
-            if channel.topic.timing is not Timing.START:
-                values = LAYOUTS[channel.topic].prepare(state.values[channel.topic])
-                for name, layout, endpoint in channel.outlets:
-                    data = layout.refill(values, endpoint, sim_time_us)
-                    if data is not None:
-                        yield name, log_time, data
+        for channel, values in zip(self._stepped, state.values, strict=True):
+            values = channel.prepare(values)
+            for name, layout, endpoint in channel.outlets:
+                data = layout.refill(values, endpoint, sim_time_us)
+                if data is not None:
+                    yield name, log_time, data
 
     def publications(self, state: StepState) -> int:
         """How many messages :meth:`step` makes of ``state`` (without building them)."""
         count = 0
-        for channel in self._channels:
+        for channel, values in zip(self._stepped, state.values, strict=True):
             if channel.topic.timing is Timing.STEP:
                 count += len(channel.outlets)
-            elif channel.topic.timing is Timing.MEASURED:
-                values = state.values[channel.topic]
+            else:
                 count += sum(values.measured(e.robot, e.ranger) is not None for _, _, e in channel.outlets)
         return count

@@ -32,7 +32,7 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic) -> None:
     compared = 0
     for _ in range(12):
         sim.step()
-        values = StepState.capture(sim, names, [topic]).values[topic]
+        (values,) = StepState.capture(sim, names, [topic]).values
         prepared = LAYOUTS[topic].prepare(values)
         for endpoint, layout, msg in zip(endpoints, layouts, messages, strict=True):
             filled = TOPIC_MESSAGES[topic].fill(msg, values, endpoint, _time(sim.sim_time_us))
