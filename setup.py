@@ -23,7 +23,8 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.*")) for folder in DATA_FOLDERS],
     ],
-    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp", "mcap", "rosbags"],
+    install_requires=["setuptools", "numpy", "numba", "pyyaml", "pillow", "aiohttp", "foxglove-sdk==0.30.3", "mcap",
+                      "rosbags"],
     extras_require={
         "test": ["pytest", "playwright", "mcap-ros2-support"],
         # Reinforcement-learning environments (stage_sim.envs); ray adds the scale-out example.

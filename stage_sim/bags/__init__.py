@@ -1,7 +1,7 @@
 """ROS 2 bags (MCAP) of a running simulation, written without ROS: what stageros publishes, topic for topic.
 
 ``BagRecorder`` (recorder.py) records a simulation step by step from a writer thread; the container
-(container.py, the ``mcap`` library) and the messages (messages.py, ``rosbags``' classes and CDR) follow what
-``ros2 bag record -s mcap`` writes; topics, names and field values come from :mod:`stage_sim.interface`, as
-the ROS layer's do; recover.py rescues a file cut short.
+(container.py, foxglove-sdk's MCAP writer) and the messages (messages.py, ``rosbags``' classes and CDR,
+refilled in place each step by layouts.py) follow what ``ros2 bag record -s mcap`` writes; topics, names and
+field values come from :mod:`stage_sim.interface`, as the ROS layer's do; recover.py rescues a file cut short.
 """

@@ -1,32 +1,43 @@
-"""The MCAP file of a bag, laid out as ``ros2 bag record -s mcap`` (Jazzy) writes one, via the ``mcap`` library.
+"""The MCAP file of a bag, laid out as ``ros2 bag record -s mcap`` (Jazzy) writes one, via foxglove-sdk's writer.
 
+foxglove-sdk (``foxglove.open_mcap``) writes MCAP in Rust: chunking, zstd and the index cost the writer
+thread a fraction of what the pure-Python ``mcap`` writer did (see docs/bags.md, "What recording costs").
 Profile ``ros2``; one schema per message type (``ros2msg`` encoding: the definition with its dependencies,
 as rosbag2 embeds it); one channel per topic (``cdr``) whose metadata holds ``offered_qos_profiles`` and
 ``topic_type_hash``; a ``rosbag2`` metadata record saying the bag is of metadata version 9 (string QoS
-enums), written first so that a file cut short (kill -9) still says so after ``stage_sim recover``.
+enums), written first so that a file cut short (kill -9) still says so after ``stage_sim recover``. The
+library writes a channel (and its schema) just before its first message: a topic nothing was published on
+is not in the bag.
 
-Chunks are zstd-compressed and flushed to the operating system as soon as the library completes one, so
-after a kill -9 everything up to the last completed chunk is on disk. A recording paced to the wall clock
-also closes a chunk once it spans a wall second's worth of sim time (CHUNK_WALL_SECONDS × speedup), so a kill -9
-loses about a second of it; a run that is not paced closes chunks by size only (a chunk a sim second would cost
-it more than the writing, and its wall seconds hold many chunks anyway). Closing by sim time, not by the wall
-clock, keeps a recording's bytes the same from run to run.
+Chunks are zstd-compressed (level 1: the writer shares the CPU with the simulation) and go to an unbuffered
+file, so after a kill -9 everything up to the last completed chunk is on disk. A recording paced to the wall
+clock also closes a chunk once it spans a wall second's worth of sim time (CHUNK_WALL_SECONDS × speedup), so a
+kill -9 loses about a second of it; a run that is not paced closes chunks by size only (a chunk a sim second
+would cost it more than the writing, and its wall seconds hold many chunks anyway). Closing by sim time, not by
+the wall clock, keeps a recording's bytes the same from run to run.
 """
 
 from __future__ import annotations
 
 import contextlib
-from io import BufferedWriter
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any, TypeVar
 
-from mcap.writer import CompressionType, Writer
+import foxglove
+from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from rosbags.typesys.store import Typestore
 
 from stage_sim.bags.errors import BAG_SUFFIX, BagError
 from stage_sim.bags.topics import Topic, yaml_text
 
+_T = TypeVar("_T")
+
 CHUNK_BYTES = 1024 * 1024
 """Uncompressed bytes per chunk at most (the mcap and rosbag2 default)."""
+COMPRESSION_LEVEL = 1
+"""zstd level of the chunks: the fastest, as the writer shares the CPU with the simulation (bags of scans
+compress about as well at 1 as at the library's default, 3)."""
 CHUNK_WALL_SECONDS = 1.0
 """Wall seconds (at the run's speedup) one chunk of a paced recording spans at most: what a kill -9 loses of a
 slow recording (one robot at real time fills a 1 MiB chunk in about 28 s)."""
@@ -57,12 +68,38 @@ def _rosbag2_metadata(path: Path) -> str:
     return yaml_text(info)
 
 
+class _File:
+    """The bag's file as the Rust writer sees it: every write goes straight to the operating system. The first
+    OSError (full disk, file size limit) is kept for :class:`McapBag` to raise, and from then on (and once
+    closed) writes are dropped: the library would only print its own report of each, and the bag is over."""
+
+    def __init__(self, path: Path) -> None:
+        self._file = open(path, "wb", buffering=0)  # noqa: SIM115 - closed by close()
+        self.error: OSError | None = None
+
+    def write(self, data: bytes | bytearray) -> int:
+        if self.error is None and not self._file.closed:
+            try:
+                self._file.write(data)
+            except OSError as exc:
+                self.error = exc
+        return len(data)
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        return 0 if self._file.closed else self._file.seek(offset, whence)
+
+    def flush(self) -> None:
+        """Nothing is buffered here."""
+
+    def close(self) -> None:
+        self._file.close()
+
+
 class McapBag:
     """An open bag: register the topics once, then :meth:`write` messages; :meth:`finish` writes the index."""
 
-    def __init__(self, path: Path, topics: list[Topic], typestore: Typestore, library: str,
-                 speedup: float = 0.0) -> None:
-        """Create ``path`` (replacing a file there) and write everything but the messages; ``speedup`` is the
+    def __init__(self, path: Path, topics: list[Topic], typestore: Typestore, speedup: float = 0.0) -> None:
+        """Create ``path`` (replacing a file there) and write its header and rosbag2 metadata; ``speedup`` is the
         run's (``<= 0``: not paced, chunks close by size only).
 
         Raises BagError when the file cannot be created or written (missing folder, no permission, full disk)
@@ -71,61 +108,79 @@ class McapBag:
         if path.suffix != BAG_SUFFIX:
             raise BagError(f"bag {path} must end in {BAG_SUFFIX} (readers choose the format by that suffix)")
         try:
-            self._stream: BufferedWriter = open(path, "wb")  # noqa: SIM115 - closed by finish()/abort()
+            self._file = _File(path)
         except OSError as exc:
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
-        self._writer = Writer(self._stream, chunk_size=CHUNK_BYTES, compression=CompressionType.ZSTD)
-        self._channels: dict[str, int] = {}
+        self._context = foxglove.Context()
+        self._channels: dict[str, foxglove.Channel] = {}
+        options = MCAPWriteOptions(profile=PROFILE, chunk_size=CHUNK_BYTES, compression=MCAPCompression.Zstd,
+                                   compression_level=COMPRESSION_LEVEL, compression_threads=0)
         try:
-            self._writer.start(profile=PROFILE, library=library)
-            self._writer.add_metadata("rosbag2", {"serialized_metadata": _rosbag2_metadata(path)})
-            schemas: dict[str, int] = {}
-            for topic in topics:
-                if topic.msgtype not in schemas:
-                    text, _ = typestore.generate_msgdef(topic.msgtype, ros_version=2)
-                    schemas[topic.msgtype] = self._writer.register_schema(topic.msgtype, "ros2msg", text.encode())
-                metadata = {"offered_qos_profiles": topic.offered_qos_profiles(),
-                            "topic_type_hash": typestore.hash_rihs01(topic.msgtype)}
-                self._channels[topic.name] = self._writer.register_channel(
-                    topic.name, "cdr", schemas[topic.msgtype], metadata)
-            self._stream.flush()
+            self._writer = self._io(foxglove.open_mcap, self._file, context=self._context, writer_options=options)
+            self._io(self._writer.write_metadata, "rosbag2", {"serialized_metadata": _rosbag2_metadata(path)})
         except OSError as exc:
             self.abort()
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
-        self._written = self._stream.tell()
+        schemas: dict[str, foxglove.Schema] = {}
+        for topic in topics:
+            if topic.msgtype not in schemas:
+                text, _ = typestore.generate_msgdef(topic.msgtype, ros_version=2)
+                schemas[topic.msgtype] = foxglove.Schema(name=topic.msgtype, encoding="ros2msg", data=text.encode())
+            metadata = {"offered_qos_profiles": topic.offered_qos_profiles(),
+                        "topic_type_hash": typestore.hash_rihs01(topic.msgtype)}
+            self._channels[topic.name] = foxglove.Channel(topic.name, schema=schemas[topic.msgtype],
+                                                          message_encoding="cdr", context=self._context,
+                                                          metadata=metadata)
+        # The channels' own log(data, log_time), without the wrapper's checks for JSON and str messages.
+        self._log = {name: channel.base.log for name, channel in self._channels.items()}
         self._chunk_start_ns: int | None = None
         self._chunk_span_ns = round(CHUNK_WALL_SECONDS * speedup * 1e9) if speedup > 0 else None
 
+    def _io(self, call: Callable[..., _T], *args: Any, **kwargs: Any) -> _T:
+        """``call`` of the library, whose failure to write (a RuntimeError) is raised as the file's OSError."""
+        try:
+            return call(*args, **kwargs)
+        except RuntimeError:
+            if self._file.error is None:
+                raise
+            raise self._file.error from None
+
     def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
         """Add one message (log and publish time = its sim stamp); raises OSError when the disk refuses."""
-        self._writer.add_message(self._channels[topic], log_time_ns, data, log_time_ns)
-        if self._stream.tell() != self._written:  # the library has just completed a chunk: hand it to the OS
-            self._stream.flush()
-            self._written = self._stream.tell()
-            self._chunk_start_ns = None
-        elif self._chunk_span_ns is None:
+        self._log[topic](data, log_time_ns)
+        if self._file.error is not None:  # the library only logs a failed write of a chunk
+            raise self._file.error
+        if self._chunk_span_ns is None:
             return
-        elif self._chunk_start_ns is None:
+        if self._chunk_start_ns is None:
             self._chunk_start_ns = log_time_ns
         elif log_time_ns - self._chunk_start_ns >= self._chunk_span_ns:
             self.flush()
 
     def flush(self) -> None:
-        """Close the open chunk and hand everything to the operating system (survives a kill -9 from now on)."""
-        self._writer.flush()
-        self._written = self._stream.tell()
+        """Close the open chunk and hand everything to the operating system (survives a kill -9 from now on);
+        raises OSError when the disk refuses."""
+        self._io(self._writer.flush)
         self._chunk_start_ns = None
 
     def finish(self, metadata: dict[str, str] | None = None) -> None:
-        """Write the last chunk, ``metadata`` (a ``stage_sim`` record), the summary and the footer; close."""
+        """Write the last chunk, ``metadata`` (a ``stage_sim`` record), the summary and the footer; close.
+        Raises OSError when the disk refuses."""
         try:
             if metadata:
-                self._writer.add_metadata("stage_sim", metadata)
-            self._writer.finish()
+                self._io(self._writer.write_metadata, "stage_sim", metadata)
+            self._io(self._writer.close)
         finally:
-            self._stream.close()
+            self._close_channels()
+            self._file.close()
 
     def abort(self) -> None:
         """Close without a summary (after a write error): what reached the disk stays readable."""
+        self._close_channels()
         with contextlib.suppress(OSError):
-            self._stream.close()
+            self._file.close()
+
+    def _close_channels(self) -> None:
+        for channel in self._channels.values():
+            channel.close()
+        self._channels = {}

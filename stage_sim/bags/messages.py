@@ -4,25 +4,28 @@ rosbags rather than mcap-ros2-support: its type store ships the Jazzy definition
 generates the ros2msg schema text and RIHS01 type hashes rosbag2 records, and serialises numpy arrays
 without a Python loop per element (about 10 µs for a 240-beam scan).
 
-The stepping thread only takes a :class:`StepState` (a few array copies); building and serialising the
-messages happens on the bag's writer thread. The topics and their values come from the interface registry
-(:mod:`stage_sim.interface.topics`), the one the ROS layer publishes from; this module holds one message
-filler per topic, as :mod:`stage_sim.ros.topic_messages` does for rclpy.
+The stepping thread only takes a :class:`StepState` (a few array copies); the messages are made on the bag's
+writer thread. The topics and their values come from the interface registry (:mod:`stage_sim.interface.topics`),
+the one the ROS layer publishes from; this module holds one message filler per topic, as
+:mod:`stage_sim.ros.topic_messages` does for rclpy. The latched messages are filled and serialised by rosbags;
+the per-step ones are serialised by rosbags once per endpoint (:func:`template`) and then refilled in those
+bytes (:mod:`stage_sim.bags.layouts`), which costs a fraction of a serialisation.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 from rosbags.typesys import Stores, get_typestore
 
+from stage_sim.bags.layouts import BoolLayout, ClockLayout, Layout, OdometryLayout, ScanLayout, TransformsLayout
 from stage_sim.bags.topics import Topic as RecordedTopic
 from stage_sim.interface import fields, frames, topics
 from stage_sim.interface.names import RobotNames
-from stage_sim.interface.topics import Endpoint, Fill, Timing, Topic, TopicMessage
+from stage_sim.interface.topics import Endpoint, Timing, Topic, TopicMessage
 from stage_sim.sim.simulation import Simulation
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -56,13 +59,14 @@ class StepState:
     """What one step publishes, copied off the simulation so the writer thread can build it later."""
 
     sim_time_us: int
-    values: dict[Topic, Any]
-    """The values of every per-step topic (:attr:`Topic.values`)."""
+    values: list[Any]
+    """The values (:attr:`Topic.values`) of the per-step topics it was captured for, in their order (a list,
+    not a dict by topic: hashing a Topic, a dataclass of enums, every step cost more than the copies)."""
 
     @classmethod
     def capture(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> StepState:
         """Copy the state of the step just taken (cheap: small arrays and references to the fresh scans)."""
-        return cls(sim.sim_time_us, {topic: _owned(topic.values(sim, names)) for topic in stepped})
+        return cls(sim.sim_time_us, [_owned(topic.values(sim, names)) for topic in stepped])
 
 
 def _time(sim_time_us: int) -> object:
@@ -186,13 +190,35 @@ TOPIC_MESSAGES: dict[Topic, TopicMessage] = {
 """The message of every topic stageros publishes (a test holds this to :data:`topics.PUBLISHED`)."""
 
 
+LAYOUTS: dict[Topic, type[Layout]] = {
+    topics.CLOCK: ClockLayout, topics.ODOM: OdometryLayout, topics.GROUND_TRUTH: OdometryLayout,
+    topics.STALL: BoolLayout, topics.SCAN: ScanLayout, topics.TF: TransformsLayout,
+}
+"""The CDR layout of every topic published each step (a test holds this to the per-step topics)."""
+
+
+def template(topic: Topic, endpoint: Endpoint, sim: Simulation, names: Sequence[RobotNames]) -> bytes:
+    """An endpoint's message serialised once by rosbags, the bytes its :data:`LAYOUTS` entry refills: built as
+    :data:`TOPIC_MESSAGES` builds it, with a scan's ranges and intensities already as many as its beams."""
+    message = TOPIC_MESSAGES[topic]
+    msg = message.build(endpoint, sim, names)
+    if topic is topics.SCAN:
+        beams = np.zeros(sim.robots[endpoint.robot].rangers[endpoint.ranger].sensor.samples, np.float32)
+        msg.ranges, msg.intensities = beams, beams
+    else:
+        msg = message.fill(msg, topic.values(sim, names), endpoint, _time(0))
+    return bytes(TYPESTORE.serialize_cdr(msg, topic.msgtype))
+
+
 @dataclass
 class _Channel:
-    """One interface topic in the bag: its filler and, per recorded endpoint, the bag topic and built message."""
+    """One interface topic in the bag and, per recorded endpoint, its bag topic, message maker and endpoint:
+    a :class:`Layout` for the per-step topics, the built rosbags message for the latched ones."""
 
     topic: Topic
-    fill: Fill
     outlets: list[tuple[str, Any, Endpoint]]
+    prepare: Callable[[Any], Any] | None = None
+    """The per-step topics' :meth:`Layout.prepare`."""
 
 
 class MessageBuilder:
@@ -203,12 +229,18 @@ class MessageBuilder:
         self._names = names
         self._channels: list[_Channel] = []
         for topic in topics.PUBLISHED:
-            outlets = [(r.name, TOPIC_MESSAGES[topic].build(r.endpoint, sim, names), r.endpoint)
-                       for r in recorded if r.endpoint.topic is topic]
-            if outlets:
-                self._channels.append(_Channel(topic, TOPIC_MESSAGES[topic].fill, outlets))
-        self.stepped = [c.topic for c in self._channels if c.topic.timing is not Timing.START]
-        """The recorded topics published every step: what :meth:`StepState.capture` takes."""
+            endpoints = [(r.name, r.endpoint) for r in recorded if r.endpoint.topic is topic]
+            if not endpoints:
+                continue
+            if topic.timing is Timing.START:
+                outlets = [(name, TOPIC_MESSAGES[topic].build(e, sim, names), e) for name, e in endpoints]
+                self._channels.append(_Channel(topic, outlets))
+            else:
+                outlets = [(name, LAYOUTS[topic](template(topic, e, sim, names)), e) for name, e in endpoints]
+                self._channels.append(_Channel(topic, outlets, LAYOUTS[topic].prepare))
+        self._stepped = [c for c in self._channels if c.topic.timing is not Timing.START]
+        self.stepped = [c.topic for c in self._stepped]
+        """The recorded topics published every step: what :meth:`StepState.capture` takes, in this order."""
 
     def static(self, sim: Simulation) -> Iterator[tuple[str, int, bytes]]:
         """The latched messages stageros sends once at start: /tf_static, and /map when recorded."""
@@ -216,31 +248,28 @@ class MessageBuilder:
         log_time = fields.stamp_ns(sim.sim_time_us)
         for channel in self._channels:
             if channel.topic.timing is Timing.START:
-                yield from self._publish(channel, channel.topic.values(sim, self._names), time, log_time)
+                fill, values = TOPIC_MESSAGES[channel.topic].fill, channel.topic.values(sim, self._names)
+                for name, msg, endpoint in channel.outlets:
+                    data = TYPESTORE.serialize_cdr(fill(msg, values, endpoint, time), channel.topic.msgtype)
+                    yield name, log_time, bytes(data)
 
     def step(self, state: StepState) -> Iterator[tuple[str, int, bytes]]:
         """Everything one step publishes on the recorded topics, in stageros' publishing order."""
-        time = _time(state.sim_time_us)
-        log_time = fields.stamp_ns(state.sim_time_us)
-        for channel in self._channels:
-            if channel.topic.timing is not Timing.START:
-                yield from self._publish(channel, state.values[channel.topic], time, log_time)
+        sim_time_us = state.sim_time_us
+        log_time = fields.stamp_ns(sim_time_us)
+        for channel, values in zip(self._stepped, state.values, strict=True):
+            values = channel.prepare(values)
+            for name, layout, endpoint in channel.outlets:
+                data = layout.refill(values, endpoint, sim_time_us)
+                if data is not None:
+                    yield name, log_time, data
 
     def publications(self, state: StepState) -> int:
         """How many messages :meth:`step` makes of ``state`` (without building them)."""
         count = 0
-        for channel in self._channels:
+        for channel, values in zip(self._stepped, state.values, strict=True):
             if channel.topic.timing is Timing.STEP:
                 count += len(channel.outlets)
-            elif channel.topic.timing is Timing.MEASURED:
-                values = state.values[channel.topic]
+            else:
                 count += sum(values.measured(e.robot, e.ranger) is not None for _, _, e in channel.outlets)
         return count
-
-    @staticmethod
-    def _publish(channel: _Channel, values: Any, time: object, log_time: int) -> Iterator[tuple[str, int, bytes]]:
-        msgtype = channel.topic.msgtype
-        for name, msg, endpoint in channel.outlets:
-            filled = channel.fill(msg, values, endpoint, time)
-            if filled is not None:
-                yield name, log_time, TYPESTORE.serialize_cdr(filled, msgtype)

@@ -34,7 +34,6 @@ wake-up costs the stepping thread a hand-over of the GIL, so waking per step wou
 WAKE_S = 0.1
 QUEUE_BYTES = 64 * 1024 * 1024
 """Memory the queue of pending steps may hold (ranges and intensities dominate: 8 bytes per beam)."""
-LIBRARY = "stage_sim bags (mcap + rosbags)"
 
 
 @dataclass(frozen=True)
@@ -83,7 +82,7 @@ class BagRecorder:
         self._names = names
         self.topics = select(stageros_topics(names, with_map, namespace), topics, namespace)
         self._builder = MessageBuilder(sim, names, self.topics)
-        self._bag = McapBag(Path(path), self.topics, TYPESTORE, LIBRARY, speedup)
+        self._bag = McapBag(Path(path), self.topics, TYPESTORE, speedup)
         self.messages = self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
         self.summary: BagSummary | None = None

@@ -4,7 +4,9 @@ Each :class:`Topic` says its name rule (absolute for the world, relative under a
 ranger), its message type, its QoS, when it is published and which values of a :class:`Simulation` its
 messages carry. The ROS node (:mod:`stage_sim.ros.stageros`) advertises and publishes them in a loop over
 this registry, the bag recorder (:mod:`stage_sim.bags`) records the same list; each side keeps one message
-filler per topic (:mod:`stage_sim.ros.topic_messages`, :mod:`stage_sim.bags.messages`).
+filler per topic (:mod:`stage_sim.ros.topic_messages`, :mod:`stage_sim.bags.messages`). The bag side fills
+its rosbags messages only for the latched topics and for the one template per endpoint of the per-step ones,
+whose serialised bytes it then refills in place (:mod:`stage_sim.bags.layouts`).
 """
 
 from __future__ import annotations
@@ -85,7 +87,8 @@ Fill = Callable[[Any, Any, Endpoint, Any], Any]
 @dataclass(frozen=True)
 class TopicMessage:
     """How one writer of messages (rclpy in :mod:`stage_sim.ros`, rosbags in :mod:`stage_sim.bags`) makes a
-    topic's message: built once per endpoint, refilled for every publication."""
+    topic's message: built once per endpoint, refilled for every publication (the bags refill the bytes of
+    the per-step messages instead, from a template this makes)."""
 
     build: Build
     fill: Fill

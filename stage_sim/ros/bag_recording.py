@@ -42,8 +42,8 @@ def bag_recording(stage: StageRos, args: argparse.Namespace, prog: str) -> Itera
     try:
         from stage_sim.bags.recorder import BagRecorder
     except ImportError as error:  # a ROS install whose rosdep did not bring the bag libraries
-        raise BagError(f"--bag needs the Python package '{error.name or error}' (pip install mcap mcap-ros2-support "
-                       "rosbags)") from error
+        raise BagError(f"--bag needs the Python package '{error.name or error}' (pip install foxglove-sdk==0.30.3 "
+                       "mcap mcap-ros2-support rosbags)") from error
 
     recorder = BagRecorder(stage.sim, args.bag, stage.names, namespace=stage.get_namespace(),
                            topics=args.bag_topics, with_map=stage.publish_map, prog=prog,

@@ -13,7 +13,7 @@ from importlib.abc import MetaPathFinder
 
 class Missing(MetaPathFinder):
     def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in {"aiohttp", "mcap", "mcap_ros2", "rosbags"}:
+        if name.split(".")[0] in {"aiohttp", "foxglove", "mcap", "mcap_ros2", "rosbags"}:
             raise ModuleNotFoundError(f"No module named {name!r}", name=name)
 
 sys.meta_path.insert(0, Missing())
@@ -40,6 +40,6 @@ def test_without_aiohttp_stageros_runs_on_without_its_view(tmp_path: Path) -> No
 def test_without_the_bag_libraries_bag_exits_2_naming_what_to_install(tmp_path: Path) -> None:
     result = run_stageros(tmp_path, "-g", "--bag", str(tmp_path / "run.mcap"))
     assert result.returncode == 2
-    assert "--bag needs the Python package 'mcap'" in result.stderr and "pip install" in result.stderr
+    assert "--bag needs the Python package 'foxglove'" in result.stderr and "pip install" in result.stderr
     assert "Traceback" not in result.stderr
     assert not (tmp_path / "run.mcap").exists()
