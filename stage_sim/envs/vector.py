@@ -22,7 +22,7 @@ from gymnasium.vector.utils import batch_space
 
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar
-from stage_sim.envs.task import NavigationTask, RewardConfig, TaskConfig, body_commands, score, step_result
+from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, body_commands, score, step_result
 
 
 class NavigateVectorEnv(gymnasium.vector.VectorEnv):
@@ -83,6 +83,21 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         """One step of every world; worlds whose episode ended at the last step are reset instead."""
         restart = self._autoreset.copy()
         moving = ~restart
+        result = self.advance(actions, moving)
+        observations = result.observations
+        for world in np.flatnonzero(restart):
+            observations[world] = self._reset_world(world, None)
+        self._autoreset = result.terminated | result.truncated
+        infos = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
+                 "time": self.steps * self._interval}
+        infos.update({f"_{key}": moving.copy() for key in list(infos)})
+        if restart.any():
+            infos["goal"], infos["_goal"] = self.goals.copy(), restart
+        return observations, result.rewards, result.terminated, result.truncated, infos
+
+    def advance(self, actions: np.ndarray, moving: np.ndarray) -> StepResult:
+        """Step the worlds in ``moving`` (the others stand) and score them as arrays: (W,) results, nothing
+        for the worlds that stood. No reset: whoever calls it decides what an ended episode leads to."""
         commands = body_commands(self.actions.commands(actions))
         for world in np.flatnonzero(moving):
             sim = self.tasks[world].sim
@@ -99,17 +114,8 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         observations = self._observer.observe_arrays(ranges, velocity, distance, bearing)
         stalled = np.array([sim.stalled[robot] for sim in sims])
         outcome = score(self.config.reward, before, distance, stalled)
-        result = step_result(outcome, observations, distance, moving, self.steps >= self.config.max_steps)
         self.distance = distance
-        for world in np.flatnonzero(restart):
-            observations[world] = self._reset_world(world, None)
-        self._autoreset = result.terminated | result.truncated
-        infos = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
-                 "time": self.steps * self._interval}
-        infos.update({f"_{key}": moving.copy() for key in list(infos)})
-        if restart.any():
-            infos["goal"], infos["_goal"] = self.goals.copy(), restart
-        return observations, result.rewards, result.terminated, result.truncated, infos
+        return step_result(outcome, observations, distance, moving, self.steps >= self.config.max_steps)
 
     def _reset_world(self, world: int, seed: int | None) -> np.ndarray:
         """Reset world ``world`` as ``NavigateEnv.reset(seed=seed)`` would and return its first observation."""
