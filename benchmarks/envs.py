@@ -41,6 +41,9 @@ def single_speed(seconds: float) -> dict:
     """Env steps per wall second of the Gymnasium env, resets included."""
     env = NavigateEnv(scenario="random", **ARENA)
     env.reset(seed=0)
+    # The process's first simulation steps on numpy until numba is loaded in the background: time numba only.
+    env.task.sim.wait_for_kernels()
+    env.step(ARC)
     core = time_core(env.task.sim)
     steps, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
