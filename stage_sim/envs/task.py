@@ -148,9 +148,9 @@ class NavigationTask:
         self.sim.step()
         self.steps += 1
         before = self.distance
-        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        self.distance, bearing = goal_polar(self.sim.true_poses[self._agent_rows], self.goals)
         observations = self._observer.observe(self.sim, self.distance, bearing)
-        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self.agents])
+        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self._agent_rows])
         active = self.active.copy()
         result = step_result(outcome, observations, self.distance, active, self.steps >= self.config.max_steps)
         self.active &= ~(result.terminated | result.truncated)
