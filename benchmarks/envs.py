@@ -8,6 +8,10 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   0.3 rad/s); episodes that end (a collision, the 500-step limit) are reset, and resets count in the time.
   ``core_share`` is the part of that time spent inside ``Simulation.step`` (moving robots, casting every
   laser); the rest is the environments' own work (observations, rewards, dicts, resets).
+  ``NavigateVectorEnv`` (``--worlds``, default 64 one-robot worlds) counts env steps summed over its worlds.
+  For the parallel env, ``robot_steps_per_s`` counts every robot of every step (every laser is cast every
+  step, also those of agents that are done and stay as obstacles) and ``agent_steps_per_s`` only the live
+  agents.
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -25,7 +29,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from stage_sim.envs import NavigateEnv, NavigateParallelEnv
+from stage_sim.envs import NavigateEnv, NavigateParallelEnv, NavigateVectorEnv
 from stage_sim.envs.rollouts import run_parallel, run_single, summarise
 from stage_sim.sim.simulation import Simulation
 
@@ -37,6 +41,9 @@ def single_speed(seconds: float) -> dict:
     """Env steps per wall second of the Gymnasium env, resets included."""
     env = NavigateEnv(scenario="random", **ARENA)
     env.reset(seed=0)
+    # The process's first simulation steps on numpy until numba is loaded in the background: time numba only.
+    env.task.sim.wait_for_kernels()
+    env.step(ARC)
     core = time_core(env.task.sim)
     steps, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
@@ -47,6 +54,23 @@ def single_speed(seconds: float) -> dict:
     elapsed = time.perf_counter() - start
     return {"bench": "speed", "env": "NavigateEnv", "robots": 1, "steps": steps,
             "env_steps_per_s": round(steps / elapsed, 1), "core_share": round(core[0] / elapsed, 3)}
+
+
+def vector_speed(worlds: int, seconds: float) -> dict:
+    """Env steps per wall second (summed over worlds) of the vector env, autoresets included."""
+    envs = NavigateVectorEnv(worlds, scenario="random", **ARENA)
+    envs.reset(seed=0)
+    core = [0.0]
+    for task in envs.tasks:
+        core = time_core(task.sim, core)
+    actions = np.repeat(ARC[None], worlds, axis=0)
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        envs.step(actions)
+        steps += 1
+    elapsed = time.perf_counter() - start
+    return {"bench": "speed", "env": "NavigateVectorEnv", "robots": 1, "worlds": worlds, "steps": steps * worlds,
+            "env_steps_per_s": round(steps * worlds / elapsed, 1), "core_share": round(core[0] / elapsed, 3)}
 
 
 def parallel_speed(robots: int, seconds: float) -> dict:
@@ -64,13 +88,15 @@ def parallel_speed(robots: int, seconds: float) -> dict:
         steps += 1
     elapsed = time.perf_counter() - start
     return {"bench": "speed", "env": "NavigateParallelEnv", "robots": robots, "steps": steps,
-            "env_steps_per_s": round(steps / elapsed, 1), "agent_steps_per_s": round(agent_steps / elapsed, 1),
+            "env_steps_per_s": round(steps / elapsed, 1), "robot_steps_per_s": round(steps * robots / elapsed, 1),
+            "agent_steps_per_s": round(agent_steps / elapsed, 1),
             "core_share": round(core[0] / elapsed, 3)}
 
 
-def time_core(sim: Simulation) -> list[float]:
-    """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list."""
-    spent = [0.0]
+def time_core(sim: Simulation, spent: list[float] | None = None) -> list[float]:
+    """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list (``spent``,
+    when several simulations share one)."""
+    spent = [0.0] if spent is None else spent
     step = sim.step
 
     def timed_step() -> None:
@@ -99,8 +125,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="wall seconds per speed measurement")
     parser.add_argument("--episodes", type=int, default=10, help="seeds per baseline scenario (0: speed only)")
+    parser.add_argument("--worlds", type=int, nargs="*", default=[64], help="worlds of the vector env runs")
     args = parser.parse_args()
     print(json.dumps(single_speed(args.seconds)), flush=True)
+    for worlds in args.worlds:
+        print(json.dumps(vector_speed(worlds, args.seconds)), flush=True)
     for robots in (10, 100):
         print(json.dumps(parallel_speed(robots, args.seconds)), flush=True)
     for row in baseline(args.episodes) if args.episodes > 0 else []:

@@ -84,10 +84,10 @@ def run_parallel(env: NavigateParallelEnv, seed: int | None, policy: Policy | No
 
 
 def run_vector(envs: gymnasium.vector.VectorEnv, seeds: list[int], policy: Policy) -> list[EpisodeStats]:
-    """The first episode of every sub-environment of a vector env of :class:`NavigateEnv` (e.g. an
-    ``AsyncVectorEnv``, one process per world), sub-environment i seeded with ``seeds[i]``; ``policy``
-    maps the batch of observations to the batch of actions (cast to the action space's dtype, as
-    :func:`run_single` does, so that both runs feed the simulation the same numbers)."""
+    """The first episode of every sub-environment of a vector env of :class:`NavigateEnv` (the batched
+    ``NavigateVectorEnv``, or an ``AsyncVectorEnv``, one process per world), sub-environment i seeded with
+    ``seeds[i]``; ``policy`` maps the batch of observations to the batch of actions (cast to the action
+    space's dtype, as :func:`run_single` does, so that both runs feed the simulation the same numbers)."""
     observations, _ = envs.reset(seed=list(seeds))
     count = len(seeds)
     running = np.ones(count, dtype=bool)

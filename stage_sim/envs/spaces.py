@@ -99,29 +99,46 @@ class ObservationBuilder:
 
     def reset(self, sim: Simulation) -> None:
         """Fill every agent's history with its current scan (no older scan exists yet)."""
-        self._scan_into(sim, self._history[:, -1])
+        self._normalise(self._ranges(sim), self._history[:, -1])
         self._history[:, :-1] = self._history[:, -1:]
 
     def observe(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         """Shift in the current scans and return (A, D) observations (goal distance and bearing given)."""
+        return self.observe_arrays(self._ranges(sim), sim.velocities[self.agents], distance, bearing)
+
+    def observe_arrays(
+        self, ranges: np.ndarray, velocity: np.ndarray, distance: np.ndarray, bearing: np.ndarray,
+    ) -> np.ndarray:
+        """:meth:`observe` from the agents' newest ranges (A, B) and velocities (A, 3), wherever they come
+        from (one simulation, or one per world in the vector env)."""
         self._history[:, :-1] = self._history[:, 1:]
-        self._scan_into(sim, self._history[:, -1])
-        return self.rows(sim, distance, bearing)
+        self._normalise(ranges, self._history[:, -1])
+        return self._rows(velocity, distance, bearing)
+
+    def restore(self, row: int, observation: np.ndarray) -> None:
+        """Take row ``row``'s scan history from an observation (the first one of a world reset elsewhere)."""
+        scans = self.layout.history * self.layout.beams
+        self._history[row] = observation[:scans].reshape(self.layout.history, self.layout.beams)
 
     def rows(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         """(A, D) observations from the kept history, the goals' distance and bearing and the velocities."""
+        return self._rows(sim.velocities[self.agents], distance, bearing)
+
+    def _rows(self, velocity: np.ndarray, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         count, scans = len(self.agents), self.layout.history * self.layout.beams
         rows = np.empty((count, scans + TAIL), dtype=np.float32)
         rows[:, :scans] = self._history.reshape(count, scans)
         tail = rows[:, scans:]
-        velocity = sim.velocities[self.agents]
         tail[:, 0], tail[:, 1], tail[:, 2], tail[:, 3] = distance, bearing, velocity[:, 0], velocity[:, 2]
         np.clip(tail, self._tail_low, self._tail_high, out=tail)
         return rows
 
-    def _scan_into(self, sim: Simulation, out: np.ndarray) -> None:
-        """Each agent's newest scan, normalised by the range and clipped to [0, 1], into ``out`` (A, B)."""
-        np.divide(np.stack([sim.scans[i][0].ranges for i in self.agents]), self.layout.range_max, out=out)
+    def _ranges(self, sim: Simulation) -> np.ndarray:
+        return np.stack([sim.scans[i][0].ranges for i in self.agents])
+
+    def _normalise(self, ranges: np.ndarray, out: np.ndarray) -> None:
+        """Ranges divided by the range and clipped to [0, 1], into ``out`` (A, B)."""
+        np.divide(ranges, self.layout.range_max, out=out)
         np.clip(out, 0.0, 1.0, out=out)
 
 

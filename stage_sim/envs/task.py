@@ -83,6 +83,24 @@ class StepResult:
     active: np.ndarray
 
 
+def body_commands(commands: np.ndarray) -> np.ndarray:
+    """(A, 3) body commands (v, 0, ω) for the simulation from (A, 2) commands (v, ω)."""
+    out = np.zeros((len(commands), 3))
+    out[:, 0], out[:, 2] = commands[:, 0], commands[:, 1]
+    return out
+
+
+def step_result(
+    outcome: StepOutcome, observations: np.ndarray, distance: np.ndarray, active: np.ndarray, at_limit: np.ndarray,
+) -> StepResult:
+    """The step's result: an agent's episode ends by arriving or colliding (terminated), else at the step
+    limit (truncated); inactive agents get nothing."""
+    terminated = (outcome.arrived | outcome.collided) & active
+    truncated = ~terminated & active & at_limit
+    return StepResult(observations, outcome.reward * active, terminated, truncated,
+                      outcome.arrived & active, outcome.collided & active, distance, active)
+
+
 class NavigationTask:
     """Episodes of ``scenario`` for the robots ``agents`` (default: every robot of the world)."""
 
@@ -92,6 +110,7 @@ class NavigationTask:
         self._base = Simulation(scenario.base)
         self.sim = self._base
         self.agents = list(range(len(self._base.robots))) if agents is None else list(agents)
+        self._agent_rows = np.asarray(self.agents, dtype=np.int64)
         bad = [a for a in self.agents if not 0 <= a < len(self._base.robots)]
         if bad or not self.agents:
             raise ValueError(f"no robot {bad or '(none chosen)'} in a world of {len(self._base.robots)} robots")
@@ -125,21 +144,17 @@ class NavigationTask:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
-        commands = self.actions.commands(actions) * self.active[:, None]
-        for agent, (forward, turn) in zip(self.agents, commands, strict=True):
-            self.sim.set_velocity(agent, float(forward), 0.0, float(turn))
+        self.sim.set_velocities(self._agent_rows, body_commands(self.actions.commands(actions) * self.active[:, None]))
         self.sim.step()
         self.steps += 1
         before = self.distance
-        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        self.distance, bearing = goal_polar(self.sim.true_poses[self._agent_rows], self.goals)
         observations = self._observer.observe(self.sim, self.distance, bearing)
-        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self.agents])
+        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self._agent_rows])
         active = self.active.copy()
-        terminated = (outcome.arrived | outcome.collided) & active
-        truncated = ~terminated & active & (self.steps >= self.config.max_steps)
-        self.active &= ~(terminated | truncated)
-        return StepResult(observations, outcome.reward * active, terminated, truncated,
-                          outcome.arrived & active, outcome.collided & active, self.distance, active)
+        result = step_result(outcome, observations, self.distance, active, self.steps >= self.config.max_steps)
+        self.active &= ~(result.terminated | result.truncated)
+        return result
 
     def frame(self) -> np.ndarray:
         """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""

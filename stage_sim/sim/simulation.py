@@ -135,6 +135,12 @@ class Simulation:
         self.commands[robot] = (vx, vy, va)
         self.last_command_us[robot] = self.sim_time_us
 
+    def set_velocities(self, robots: np.ndarray, commands: np.ndarray) -> None:
+        """Command several robots at once, ``commands[k]`` = (vx, vy, va) for robot ``robots[k]``: what
+        :meth:`set_velocity` does for each, in one array operation (the RL envs command every agent per step)."""
+        self.commands[robots] = commands
+        self.last_command_us[robots] = self.sim_time_us
+
     def set_pose(self, robot: int, x: float, y: float, yaw: float) -> None:
         """Put robot ``robot`` at a new true pose between steps, as dragging a model in Stage's window does.
 

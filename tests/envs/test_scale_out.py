@@ -1,4 +1,5 @@
-"""Scaling out gives the same episodes as a serial run: AsyncVectorEnv with 2 workers, Ray with 2 CPUs."""
+"""Scaling out gives the same episodes as a serial run: AsyncVectorEnv with 2 workers, the batched vector env,
+Ray with 2 CPUs."""
 
 from __future__ import annotations
 
@@ -30,6 +31,13 @@ def test_async_vector_env_with_two_workers_matches_a_serial_run():
     serial = [run_single(make_env(), seed, policy) for seed in (21, 22)]
     assert parallel == serial
     assert all(episode.steps > 1 for episode in serial)
+
+
+def test_the_batched_vector_env_in_one_process_matches_a_serial_run():
+    policy = baseline_for(make_env().unwrapped.task)
+    envs = gymnasium.make_vec(ENV_ID, num_envs=2, vectorization_mode="vector_entry_point", body=SMALL,
+                              scenario="obstacles", n_obstacles=4, max_steps=150)
+    assert run_vector(envs, [21, 22], policy) == [run_single(make_env(), seed, policy) for seed in (21, 22)]
 
 
 def test_the_ray_example_on_a_local_instance_matches_a_serial_run():

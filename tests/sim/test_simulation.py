@@ -178,6 +178,19 @@ def test_watchdog_stops_a_robot_without_commands() -> None:
     assert sim.true_poses[0][0] == x
 
 
+def test_set_velocities_commands_several_robots_as_set_velocity_does_each() -> None:
+    robots = 'bot( pose [2 2 0 0] ) bot( pose [5 5 0 0] ) bot( pose [7 2 0 0] )'
+    one_by_one, at_once = sim_of(robots), sim_of(robots)
+    one_by_one.set_velocity(2, 0.3, 0.0, 0.2)
+    one_by_one.set_velocity(0, 0.5, 0.0, -0.1)
+    at_once.set_velocities(np.array([2, 0]), np.array([[0.3, 0.0, 0.2], [0.5, 0.0, -0.1]]))
+    for _ in range(3):
+        one_by_one.step()
+        at_once.step()
+    assert np.array_equal(one_by_one.true_poses, at_once.true_poses)
+    assert at_once.true_poses[1].tolist() == [5.0, 5.0, 0.0]  # not commanded: stays
+
+
 def test_scan_range_is_the_distance_to_the_first_wall_cell() -> None:
     sim = sim_of('bot( pose [2 5 0 0] )')
     scan = sim.scans[0][0]

@@ -1,0 +1,130 @@
+"""``stage_sim/Navigate-v0`` as a Gymnasium ``VectorEnv``: N independent one-robot worlds in one process.
+
+``gymnasium.make_vec("stage_sim/Navigate-v0", num_envs=N, vectorization_mode="vector_entry_point")`` (the
+default mode for this id) builds it. World i is what ``gymnasium.make("stage_sim/Navigate-v0", ...)`` would
+be, seeded with ``seed + i`` (or ``seed[i]``), and the vector env is identical to N such envs in a
+``SyncVectorEnv`` step for step, but it does the task's work (commands, observations, rewards, episode ends)
+once for all worlds as arrays instead of once per world; only the simulation steps stay one per world.
+
+Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
+next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
+neither terminated nor truncated.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector.utils import batch_space
+
+from stage_sim.envs.scenarios import Scenario, ScenarioOptions
+from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar
+from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, body_commands, score, step_result
+
+
+class NavigateVectorEnv(gymnasium.vector.VectorEnv):
+    """``num_envs`` worlds of :class:`~stage_sim.envs.NavigateEnv` (same keyword arguments), stepped together."""
+
+    metadata: dict[str, Any] = {"autoreset_mode": gymnasium.vector.AutoresetMode.NEXT_STEP}  # noqa: RUF012
+
+    def __init__(
+        self, num_envs: int, world: str | None = None, robot: int = 0, history: int = 3, max_steps: int = 500,
+        discrete: bool = False, reward: RewardConfig | None = None, **scenario: Any,
+    ) -> None:
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be at least 1, got {num_envs}")
+        options = ScenarioOptions(world=world, **scenario)
+        if options.scenario == "circle":
+            raise ValueError("circle crossing needs several robots: use stage_sim.envs.NavigateParallelEnv")
+        self.config = TaskConfig(history, max_steps, discrete, reward or RewardConfig())
+        self.tasks = [NavigationTask(Scenario(options), self.config, agents=[robot]) for _ in range(num_envs)]
+        first = self.tasks[0]
+        self.num_envs = num_envs
+        self.robot = robot
+        self.layout = first.layout
+        self.single_observation_space = first.observation_spaces[0]
+        self.single_action_space = first.actions.space(0)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        bounds = np.array([first.sim.robots[robot].settings.velocity_bounds] * num_envs, dtype=np.float64)
+        self.actions = ActionMap(bounds, discrete)
+        self._observer = ObservationBuilder(self.layout, [robot] * num_envs, [self.single_observation_space] * num_envs)
+        self._robot_row = np.array([robot])
+        self._rngs: list[np.random.Generator | None] = [None] * num_envs
+        self.goals = np.zeros((num_envs, 2))
+        self.distance = np.zeros(num_envs)
+        self.steps = np.zeros(num_envs, dtype=np.int64)
+        self._autoreset = np.zeros(num_envs, dtype=bool)
+        self._interval = first.sim.interval
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Every world anew; world i seeded with ``seed + i`` (an int) or ``seed[i]`` (a list), as
+        ``SyncVectorEnv`` seeds its sub-environments; without a seed each world goes on with its generator."""
+        if seed is None:
+            seeds: list[int | None] = [None] * self.num_envs
+        elif isinstance(seed, int):
+            seeds = [seed + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"{len(seeds)} seeds for {self.num_envs} worlds")
+        rows = np.empty((self.num_envs, self.layout.size), dtype=np.float32)
+        for world, world_seed in enumerate(seeds):
+            rows[world] = self._reset_world(world, world_seed)
+        self._autoreset[:] = False
+        return rows, {"goal": self.goals.copy(), "_goal": np.ones(self.num_envs, dtype=bool)}
+
+    def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """One step of every world; worlds whose episode ended at the last step are reset instead."""
+        restart = self._autoreset.copy()
+        moving = ~restart
+        result = self.advance(actions, moving)
+        observations = result.observations
+        for world in np.flatnonzero(restart):
+            observations[world] = self._reset_world(world, None)
+        self._autoreset = result.terminated | result.truncated
+        infos = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
+                 "time": self.steps * self._interval}
+        infos.update({f"_{key}": moving.copy() for key in list(infos)})
+        if restart.any():
+            infos["goal"], infos["_goal"] = self.goals.copy(), restart
+        return observations, result.rewards, result.terminated, result.truncated, infos
+
+    def advance(self, actions: np.ndarray, moving: np.ndarray) -> StepResult:
+        """Step the worlds in ``moving`` (the others stand) and score them as arrays: (W,) results, nothing
+        for the worlds that stood. No reset: whoever calls it decides what an ended episode leads to."""
+        commands = body_commands(self.actions.commands(actions))
+        for world in np.flatnonzero(moving):
+            sim = self.tasks[world].sim
+            sim.set_velocities(self._robot_row, commands[world:world + 1])
+            sim.step()
+        self.steps += moving
+        sims = [task.sim for task in self.tasks]
+        robot = self.robot
+        poses = np.array([sim.true_poses[robot] for sim in sims])
+        before = self.distance
+        distance, bearing = goal_polar(poses, self.goals)
+        ranges = np.stack([sim.scans[robot][0].ranges for sim in sims])
+        velocity = np.array([sim.velocities[robot] for sim in sims])
+        observations = self._observer.observe_arrays(ranges, velocity, distance, bearing)
+        stalled = np.array([sim.stalled[robot] for sim in sims])
+        outcome = score(self.config.reward, before, distance, stalled)
+        self.distance = distance
+        return step_result(outcome, observations, distance, moving, self.steps >= self.config.max_steps)
+
+    def _reset_world(self, world: int, seed: int | None) -> np.ndarray:
+        """Reset world ``world`` as ``NavigateEnv.reset(seed=seed)`` would and return its first observation."""
+        if seed is not None or self._rngs[world] is None:
+            self._rngs[world], _ = seeding.np_random(seed)
+        task = self.tasks[world]
+        observation = task.reset(self._rngs[world])[0]
+        self.goals[world] = task.goals[0]
+        self.distance[world] = task.distance[0]
+        self.steps[world] = 0
+        self._observer.restore(world, observation)
+        return observation

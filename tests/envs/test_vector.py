@@ -1,0 +1,78 @@
+"""The vector env as a user builds it: gymnasium.make_vec, the same episodes as N separate envs, autoreset."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+
+import stage_sim.envs  # noqa: F401  (registers stage_sim/Navigate-v0)
+from stage_sim.envs import ENV_ID, NavigateVectorEnv, RobotBody
+
+SMALL = RobotBody(laser_samples=32)
+# short episodes, so that every world ends (and is autoreset) several times within the steps compared
+KWARGS = {"body": SMALL, "scenario": "obstacles", "n_obstacles": 4, "max_steps": 15}
+
+
+def make_vector(num_envs: int, **kwargs) -> gymnasium.vector.VectorEnv:
+    return gymnasium.make_vec(ENV_ID, num_envs=num_envs, vectorization_mode="vector_entry_point",
+                              **{**KWARGS, **kwargs})
+
+
+def test_make_vec_builds_the_batched_vector_env_with_batched_spaces():
+    envs = make_vector(3)
+    assert isinstance(envs, NavigateVectorEnv)
+    assert envs.observation_space.shape == (3, 3 * 32 + 4)
+    assert envs.action_space.shape == (3, 2)
+    assert envs.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_identical_step_for_step_to_n_separate_envs_with_the_same_seeds(discrete):
+    count = 4
+    batched = make_vector(count, discrete=discrete)
+    separate = gymnasium.vector.SyncVectorEnv(
+        [lambda: gymnasium.make(ENV_ID, discrete=discrete, **KWARGS) for _ in range(count)])
+    first, _ = batched.reset(seed=11)
+    expected, _ = separate.reset(seed=11)
+    assert np.array_equal(first, expected)
+    batched.action_space.seed(5)
+    ended = 0
+    for _ in range(60):
+        actions = batched.action_space.sample()
+        got = batched.step(actions)
+        want = separate.step(actions)
+        for mine, theirs in zip(got[:4], want[:4], strict=True):
+            assert mine.dtype == theirs.dtype
+            assert np.array_equal(mine, theirs)
+        ended += int(np.sum(got[2] | got[3]))
+    assert ended >= count  # the comparison went through autoresets, not just one episode per world
+    # a reset with a list of seeds, then more steps: still the same
+    assert np.array_equal(batched.reset(seed=[3, 1, 4, 1])[0], separate.reset(seed=[3, 1, 4, 1])[0])
+    actions = batched.action_space.sample()
+    assert all(np.array_equal(a, b) for a, b in zip(batched.step(actions)[:4], separate.step(actions)[:4],
+                                                    strict=True))
+
+
+def test_an_ended_world_is_reset_by_the_next_step_with_reward_zero():
+    envs = make_vector(2, max_steps=3)
+    envs.reset(seed=0)
+    still = np.zeros((2, 2), dtype=np.float32)
+    for _ in range(3):
+        _, rewards, terminated, truncated, infos = envs.step(still)
+    assert truncated.tolist() == [True, True] and not terminated.any()
+    observations, rewards, terminated, truncated, infos = envs.step(still)
+    assert rewards.tolist() == [0.0, 0.0] and not (terminated | truncated).any()
+    assert infos["_goal"].tolist() == [True, True] and not infos["_arrived"].any()
+    assert observations in envs.observation_space
+
+
+def test_batches_have_the_dtypes_gymnasium_vector_envs_use_and_lie_in_the_spaces():
+    # Gymnasium 1.4 has no checker for vector envs (check_env takes single envs only): the contract by hand.
+    envs = make_vector(2)
+    observations, _ = envs.reset(seed=0)
+    assert observations in envs.observation_space
+    observations, rewards, terminated, truncated, _ = envs.step(envs.action_space.sample())
+    assert observations in envs.observation_space
+    assert (rewards.dtype, terminated.dtype, truncated.dtype) == (np.float64, np.bool_, np.bool_)
+    assert rewards.shape == terminated.shape == truncated.shape == (2,)
