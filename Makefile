@@ -67,7 +67,8 @@ define bench_run
 endef
 
 bench: setup
-	@mkdir -p $(BENCH_DATA) && rm -f $(BENCH_DATA)/*.jsonl $(BENCH_DATA)/*.command
+	@mkdir -p $(BENCH_DATA) && find $(BENCH_DATA) -maxdepth 1 \( -name '*.jsonl' -o -name '*.command' \) \
+	  ! -name 'rl_peers.*' -delete
 	@printf '{"cores": %s, "cpu": "%s", "quick": %s}\n' "$$(nproc)" \
 	  "$$(lscpu | sed -n 's/^Model name: *//p' | head -1)" "$(if $(QUICK),true,false)" > $(BENCH_DATA)/machine.json
 	$(call bench_run,raycast,python benchmarks/raycast.py)
@@ -104,6 +105,27 @@ train: $(TRAIN_VENV)/.package.stamp
 	@mkdir -p $(TRAIN_DATA)
 	@echo 'python examples/train_ppo.py $(TRAIN_ARGS)' > $(TRAIN_DATA)/ppo_obstacles.command
 	nice $(TRAIN_VENV)/bin/python examples/train_ppo.py --out $(TRAIN_DATA)/ppo_obstacles.jsonl $(TRAIN_ARGS)
+
+# make bench-peers: benchmarks/rl_peers.py, stage_sim beside navground, irsim-x and ir-sim on one RL scenario.
+# Each peer gets a venv of its own, .venv-peers/<peer>, installed from benchmarks/peers/<peer>.lock (so that
+# their dependencies never meet stage_sim's); the run writes docs/data/bench/rl_peers.jsonl, .command, and
+# rl_peers.machine.json (cores, CPU, and NOTE, e.g. NOTE="other jobs running": its own run note in the docs).
+PEERS := navground irsim-x ir-sim
+PEER_VENVS := .venv-peers
+PEER_ARGS ?=
+NOTE ?=
+
+$(PEER_VENVS)/%/.lock.stamp: benchmarks/peers/%.lock
+	@echo "[bench-peers] $* into $(PEER_VENVS)/$*"
+	@test -x $(PEER_VENVS)/$*/bin/python || $(PYTHON_BOOTSTRAP) -m venv $(PEER_VENVS)/$*
+	@$(PEER_VENVS)/$*/bin/pip install --quiet --disable-pip-version-check -r $<
+	@touch $@
+
+bench-peers: setup $(foreach peer,$(PEERS),$(PEER_VENVS)/$(peer)/.lock.stamp)
+	@mkdir -p $(BENCH_DATA) && rm -f $(BENCH_DATA)/rl_peers.*
+	@printf '{"cores": %s, "cpu": "%s", "quick": false, "make": "make bench-peers", "note": "%s"}\n' "$$(nproc)" \
+	  "$$(lscpu | sed -n 's/^Model name: *//p' | head -1)" "$(NOTE)" > $(BENCH_DATA)/rl_peers.machine.json
+	$(call bench_run,rl_peers,python benchmarks/rl_peers.py $(PEER_ARGS))
 
 # The documentation site (mkdocs.yml, docs/) into site/, in strict mode: a broken link, reference or table fails.
 docs: setup

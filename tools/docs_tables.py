@@ -60,12 +60,16 @@ def number(value: float) -> str:
 
 
 def provenance(name: str) -> str:
-    """Which commands, run by which `make bench`, on what machine, made the file's lines."""
-    machine = json.loads((DATA / "machine.json").read_text())
-    make = "make bench QUICK=1" if machine["quick"] else "make bench"
+    """Which commands, run by which `make` target, on what machine, made the file's lines. A file measured by a
+    target of its own (``make bench-peers``) has its own ``<name>.machine.json``, with that target and a note
+    on the run; the others share ``machine.json`` of ``make bench``."""
+    own = DATA / f"{name}.machine.json"
+    machine = json.loads((own if own.is_file() else DATA / "machine.json").read_text())
+    make = machine.get("make") or ("make bench QUICK=1" if machine["quick"] else "make bench")
     commands = "; ".join(f"`{line}`" for line in (DATA / f"{name}.command").read_text().splitlines() if line)
+    note = f" ({machine['note']})" if machine.get("note") else ""
     return (f"*Measured by `{make}` on a {machine['cores']}-core machine ({machine['cpu']})"
-            f"{', short runs' if machine['quick'] else ''}: {commands}.*")
+            f"{', short runs' if machine['quick'] else ''}{note}: {commands}.*")
 
 
 def table(spec: str, columns: str) -> str:
