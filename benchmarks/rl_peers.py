@@ -21,7 +21,7 @@ step in all of them) and ``live_agent_steps_per_s`` only robots whose episode is
 episodes); min and max over ``--reps``. ``lidar_sees_robots`` is probed, not assumed: a robot 1 m straight
 ahead of another must show in the middle beam of its scan.
 
-    .venv/bin/python benchmarks/rl_peers.py [--robots 1 10 100] [--steps 300] [--reps 3] [--core 0]
+    .venv/bin/python benchmarks/rl_peers.py [--robots 1 10 100] [--seconds 3] [--reps 3] [--core 0]
 """
 
 from __future__ import annotations
@@ -57,6 +57,8 @@ CASES: dict[str, str | None] = {
 PROBE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
 #: Steps run before the clock starts (compiled kernels loaded, first scans, caches warm).
 WARM_UP = 20
+#: Random actions drawn per run (then taken again from the first).
+ACTION_ROWS = 1000
 
 
 # -- the scenario, the same numbers for every simulator ------------------------------------------------
@@ -297,18 +299,19 @@ RUNNERS: dict[str, type[Runner]] = {
 }
 
 
-def measure(case: str, robots: int, steps: int, seed: int) -> dict[str, Any]:
-    """One timed run of ``steps`` steps after the warm-up (building the world is not timed)."""
+def measure(case: str, robots: int, seconds: float, seed: int) -> dict[str, Any]:
+    """Steps for ``seconds`` of wall time after the warm-up (building the world is not timed), the random
+    actions drawn beforehand and taken in turn."""
     runner = RUNNERS[case](robots, seed)
-    commands = actions(robots, WARM_UP + steps, seed)
+    commands = actions(robots, ACTION_ROWS, seed)
     for action in commands[:WARM_UP]:
         runner.step(action)
-    live = 0
+    steps = live = 0
     start = time.perf_counter()
-    for action in commands[WARM_UP:]:
-        live += runner.step(action)
-    elapsed = time.perf_counter() - start
-    return {"agent_steps_per_s": robots * steps / elapsed, "live_agent_steps_per_s": live / elapsed,
+    while (elapsed := time.perf_counter() - start) < seconds:
+        live += runner.step(commands[steps % ACTION_ROWS])
+        steps += 1
+    return {"steps": steps, "agent_steps_per_s": robots * steps / elapsed, "live_agent_steps_per_s": live / elapsed,
             "lidar_sees_robots": runner.sees_robots}
 
 
@@ -323,8 +326,8 @@ def interpreter(case: str, venvs: Path) -> Path | None:
     return python if python.is_file() else None
 
 
-def run_case(python: Path, case: str, robots: int, steps: int, seed: int, core: int | None) -> dict[str, Any]:
-    command = [str(python), __file__, "--worker", case, "--robots", str(robots), "--steps", str(steps),
+def run_case(python: Path, case: str, robots: int, seconds: float, seed: int, core: int | None) -> dict[str, Any]:
+    command = [str(python), __file__, "--worker", case, "--robots", str(robots), "--seconds", str(seconds),
                "--seed", str(seed)]
     if core is not None and shutil.which("taskset"):
         command = ["taskset", "-c", str(core), *command]
@@ -340,7 +343,7 @@ def run_case(python: Path, case: str, robots: int, steps: int, seed: int, core: 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 10, 100])
-    parser.add_argument("--steps", type=int, default=300, help="timed steps per run")
+    parser.add_argument("--seconds", type=float, default=3.0, help="timed wall seconds per run")
     parser.add_argument("--reps", type=int, default=3, help="runs per case, alternating between simulators")
     parser.add_argument("--core", type=int, default=0, help="the core every run is pinned to (-1: no pinning)")
     parser.add_argument("--venvs", type=Path, default=REPO / ".venv-peers", help="where the peers' venvs are")
@@ -349,7 +352,7 @@ def main() -> int:
     parser.add_argument("--seed", type=int, default=0, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
-        print(json.dumps(measure(args.worker, args.robots[0], args.steps, args.seed)), flush=True)
+        print(json.dumps(measure(args.worker, args.robots[0], args.seconds, args.seed)), flush=True)
         return 0
     pythons = {case: interpreter(case, args.venvs) for case in args.cases}
     for case, python in pythons.items():
@@ -361,10 +364,10 @@ def main() -> int:
         runs: dict[str, list[dict[str, Any]]] = {case: [] for case in cases}
         for rep in range(args.reps):
             for case in cases:
-                runs[case].append(run_case(pythons[case], case, robots, args.steps, rep, core))
+                runs[case].append(run_case(pythons[case], case, robots, args.seconds, rep, core))
         for case in cases:
-            line: dict[str, Any] = {"bench": "rl_peers", "simulator": case, "robots": robots,
-                                    "steps": args.steps, "reps": args.reps}
+            line: dict[str, Any] = {"bench": "rl_peers", "simulator": case, "robots": robots, "reps": args.reps,
+                                    "steps": min(run["steps"] for run in runs[case])}
             for key in ("agent_steps_per_s", "live_agent_steps_per_s"):
                 values = [run[key] for run in runs[case]]
                 line[key] = f"{min(values):,.0f}–{max(values):,.0f}"
