@@ -24,6 +24,7 @@ from typing import Any
 
 import gymnasium
 import torch
+from gymnasium.wrappers import RescaleAction
 from stable_baselines3 import PPO
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.env_util import make_vec_env
@@ -37,9 +38,17 @@ ENV_KWARGS: dict[str, Any] = {"scenario": "obstacles", "n_obstacles": 8}
 EVAL_SEED = 1_000_000
 
 
-def evaluate(model: PPO, episodes: int, first_seed: int) -> dict[str, float]:
+def make_env(discrete: bool) -> gymnasium.Env:
+    """The env as the policy sees it: continuous actions rescaled to [-1, 1] (SB3's Gaussian starts centred
+    on 0 with unit spread; on the env's own [0, 1] m/s forward range, half its draws and a deterministic mean
+    at 0 would clip to standing still), or the env's own discrete action set."""
+    env = gymnasium.make("stage_sim/Navigate-v0", discrete=discrete, **ENV_KWARGS)
+    return env if discrete else RescaleAction(env, -1.0, 1.0)
+
+
+def evaluate(model: PPO, episodes: int, first_seed: int, discrete: bool) -> dict[str, float]:
     """Success and collision rates of the deterministic policy over ``episodes`` seeded episodes."""
-    env = gymnasium.make("stage_sim/Navigate-v0", **ENV_KWARGS)
+    env = make_env(discrete)
     arrived = collided = 0
     for seed in range(first_seed, first_seed + episodes):
         observation, _ = env.reset(seed=seed)
@@ -57,9 +66,10 @@ def evaluate(model: PPO, episodes: int, first_seed: int) -> dict[str, float]:
 class Curve(BaseCallback):
     """Evaluates every ``every`` env steps and appends one JSON line per evaluation to ``out``."""
 
-    def __init__(self, out: Path, every: int, episodes: int, started: float) -> None:
+    def __init__(self, out: Path, every: int, episodes: int, started: float, discrete: bool) -> None:
         super().__init__()
         self.out, self.every, self.episodes, self.started = out, every, episodes, started
+        self.discrete = discrete
         self.next_eval = every
         self.round = 0
 
@@ -74,7 +84,7 @@ class Curve(BaseCallback):
         if self.num_timesteps >= self.next_eval:
             self.next_eval += self.every
             # Each evaluation gets its own seeds, all unseen in training.
-            result = evaluate(self.model, self.episodes, EVAL_SEED + 10_000 * self.round)
+            result = evaluate(self.model, self.episodes, EVAL_SEED + 10_000 * self.round, self.discrete)
             self.round += 1
             self.record(result)
         return True
@@ -88,6 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--eval-episodes", type=int, default=30)
     parser.add_argument("--final-episodes", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--discrete", action="store_true", help="the env's discrete actions (15) instead of continuous")
     parser.add_argument("--out", type=Path, default=Path("docs/data/train/ppo_obstacles.jsonl"))
     parser.add_argument("--save", type=Path, default=None, help="where to save the trained policy (.zip)")
     args = parser.parse_args(argv)
@@ -96,16 +107,16 @@ def main(argv: list[str] | None = None) -> int:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text("")
     started = time.perf_counter()
-    envs = make_vec_env("stage_sim/Navigate-v0", n_envs=args.envs, seed=args.seed, env_kwargs=ENV_KWARGS,
+    envs = make_vec_env(make_env, n_envs=args.envs, seed=args.seed, env_kwargs={"discrete": args.discrete},
                         vec_env_cls=DummyVecEnv)
     model = PPO("MlpPolicy", envs, n_steps=256, batch_size=256, n_epochs=5, learning_rate=3e-4, gamma=0.99,
                 gae_lambda=0.95, ent_coef=0.0, clip_range=0.2,
                 policy_kwargs={"net_arch": [256, 256]}, seed=args.seed, verbose=0, device="cpu")
-    curve = Curve(args.out, args.eval_every, args.eval_episodes, started)
+    curve = Curve(args.out, args.eval_every, args.eval_episodes, started, args.discrete)
     model.learn(total_timesteps=args.steps, callback=curve)
     if args.save:
         model.save(args.save)
-    final = evaluate(model, args.final_episodes, EVAL_SEED - args.final_episodes)
+    final = evaluate(model, args.final_episodes, EVAL_SEED - args.final_episodes, args.discrete)
     curve.record({**final, "final": True})
     return 0
 
