@@ -10,7 +10,7 @@ PYTEST_ARGS ?=
 # Keep DDS discovery on loopback unless the user chose otherwise (project rule for every process).
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 
-.PHONY: setup run test lint bench docs clean-venv
+.PHONY: setup run test lint bench bench-peers train docs clean-venv
 
 WORLD ?= worlds/rooms.world
 RUN_ARGS ?=
@@ -67,7 +67,8 @@ define bench_run
 endef
 
 bench: setup
-	@mkdir -p $(BENCH_DATA) && rm -f $(BENCH_DATA)/*.jsonl $(BENCH_DATA)/*.command
+	@mkdir -p $(BENCH_DATA) && find $(BENCH_DATA) -maxdepth 1 \( -name '*.jsonl' -o -name '*.command' \) \
+	  ! -name 'rl_peers.*' -delete
 	@printf '{"cores": %s, "cpu": "%s", "quick": %s}\n' "$$(nproc)" \
 	  "$$(lscpu | sed -n 's/^Model name: *//p' | head -1)" "$(if $(QUICK),true,false)" > $(BENCH_DATA)/machine.json
 	$(call bench_run,raycast,python benchmarks/raycast.py)
@@ -85,6 +86,46 @@ bench: setup
 	$(call bench_run,fidelity,python benchmarks/fidelity.py)
 	$(call bench_run,wander_speed,taskset -c 0 python benchmarks/wander_speed.py $(call pick,,--steps 300))
 	$(call bench_run,wander_sweep,python benchmarks/wander_sweep.py --core --world rooms.world $(call pick,--seeds 20 --minutes 30,--seeds 2 --minutes 30 --jobs 1))
+
+# make train: PPO on the obstacles scenario (examples/train_ppo.py), its learning curve written to
+# docs/data/train/ppo_obstacles.jsonl. torch is heavy, so it lives in a venv of its own; the CPU build is
+# installed first, by itself, so that the `train` extra finds torch there and pip pulls no CUDA build. The
+# main requirements.lock is not applied here (torch needs a newer setuptools than it pins).
+TRAIN_VENV := .venv-train
+TRAIN_DATA := docs/data/train
+
+$(TRAIN_VENV)/.package.stamp: setup.py setup.cfg pyproject.toml
+	@echo "[train] creating $(TRAIN_VENV) (CPU torch, then stage_sim[train])"
+	@test -x $(TRAIN_VENV)/bin/python || $(PYTHON_BOOTSTRAP) -m venv $(TRAIN_VENV)
+	@$(TRAIN_VENV)/bin/pip install --quiet --disable-pip-version-check torch==2.13.0
+	@$(TRAIN_VENV)/bin/pip install --quiet --disable-pip-version-check torch==2.13.0 -e '.[train]'
+	@touch $@
+
+train: $(TRAIN_VENV)/.package.stamp
+	@mkdir -p $(TRAIN_DATA)
+	@echo 'python examples/train_ppo.py $(TRAIN_ARGS)' > $(TRAIN_DATA)/ppo_obstacles.command
+	nice $(TRAIN_VENV)/bin/python examples/train_ppo.py --out $(TRAIN_DATA)/ppo_obstacles.jsonl $(TRAIN_ARGS)
+
+# make bench-peers: benchmarks/rl_peers.py, stage_sim beside navground, irsim-x and ir-sim on one RL scenario.
+# Each peer gets a venv of its own, .venv-peers/<peer>, installed from benchmarks/peers/<peer>.lock (so that
+# their dependencies never meet stage_sim's); the run writes docs/data/bench/rl_peers.jsonl, .command, and
+# rl_peers.machine.json (cores, CPU, and NOTE, e.g. NOTE="other jobs running": its own run note in the docs).
+PEERS := navground irsim-x ir-sim
+PEER_VENVS := .venv-peers
+PEER_ARGS ?=
+NOTE ?=
+
+$(PEER_VENVS)/%/.lock.stamp: benchmarks/peers/%.lock
+	@echo "[bench-peers] $* into $(PEER_VENVS)/$*"
+	@test -x $(PEER_VENVS)/$*/bin/python || $(PYTHON_BOOTSTRAP) -m venv $(PEER_VENVS)/$*
+	@$(PEER_VENVS)/$*/bin/pip install --quiet --disable-pip-version-check -r $<
+	@touch $@
+
+bench-peers: setup $(foreach peer,$(PEERS),$(PEER_VENVS)/$(peer)/.lock.stamp)
+	@mkdir -p $(BENCH_DATA) && rm -f $(BENCH_DATA)/rl_peers.*
+	@printf '{"cores": %s, "cpu": "%s", "quick": false, "make": "make bench-peers", "note": "%s"}\n' "$$(nproc)" \
+	  "$$(lscpu | sed -n 's/^Model name: *//p' | head -1)" "$(NOTE)" > $(BENCH_DATA)/rl_peers.machine.json
+	$(call bench_run,rl_peers,python benchmarks/rl_peers.py $(PEER_ARGS))
 
 # The documentation site (mkdocs.yml, docs/) into site/, in strict mode: a broken link, reference or table fails.
 docs: setup

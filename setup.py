@@ -30,6 +30,8 @@ setup(
         # Reinforcement-learning environments (stage_sim.envs); ray adds the scale-out example.
         "rl": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy"],
         "ray": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy", "ray>=2.9"],
+        # PPO training (examples/train_ppo.py, `make train`): heavy, so in a venv of its own.
+        "train": ["gymnasium>=1.0", "pettingzoo>=1.24", "scipy", "stable-baselines3>=2.3", "torch"],
     },
     zip_safe=False,
     entry_points={

@@ -103,6 +103,36 @@ def test_a_table_without_its_data_fails_the_build(bench_data: Path, marker: str)
         tables.on_page_markdown(marker, None, None, None)
 
 
+def _curve(folder: Path, rows: list[dict]) -> None:
+    (folder / "tiny.jsonl").write_text("".join(json.dumps(row) + "\n" for row in rows))
+    (folder / "tiny.command").write_text("python examples/train_ppo.py --steps 20\n")
+
+
+def test_a_learning_curve_is_drawn_from_its_evaluations(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    _curve(tmp_path, [
+        {"env_steps": 10, "episodes": 4, "success_rate": 0.0, "collision_rate": 0.5, "wall_s": 1.0},
+        {"env_steps": 20, "episodes": 4, "success_rate": 0.75, "collision_rate": 0.25, "wall_s": 2.0},
+        {"env_steps": 20, "episodes": 8, "success_rate": 0.875, "collision_rate": 0.125, "wall_s": 3.0, "final": True},
+    ])
+    monkeypatch.setattr(tables, "TRAIN", tmp_path)
+    out = tables.on_page_markdown("before\n<!-- curve tiny -->\nafter", None, None, None)
+    svg = out[out.index("<svg"):out.index("</svg>")]
+    success, collisions = re.findall(r'points="([^"]+)"', svg)
+    # Two evaluations, two points per line; the final evaluation is the text under the plot, not a point.
+    assert len(success.split()) == len(collisions.split()) == 2
+    (x0, y0), (x1, y1) = (map(float, point.split(",")) for point in success.split())
+    assert x0 < x1 and y1 < y0  # later and higher: 0 % at the bottom, 75 % above it
+    assert "success 88 %, collisions 12 %, after 20 env steps" in out and "over 8 unseen seeds" in out
+    assert "`python examples/train_ppo.py --steps 20`" in out and out.startswith("before") and out.endswith("after")
+
+
+def test_a_curve_without_its_final_evaluation_fails_the_build(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    _curve(tmp_path, [{"env_steps": 10, "episodes": 4, "success_rate": 0.0, "collision_rate": 0.5, "wall_s": 1.0}])
+    monkeypatch.setattr(tables, "TRAIN", tmp_path)
+    with pytest.raises(PluginError):
+        tables.on_page_markdown("<!-- curve tiny -->", None, None, None)
+
+
 def test_the_api_reference_has_a_page_per_package_in_layer_order() -> None:
     on_disk = {path.parent.name for path in (REPO / "stage_sim").glob("*/__init__.py")}
     layers = re.search(r"contract:layers\].*?layers =\n(.*?)\n\n", (REPO / ".importlinter").read_text(), re.DOTALL)

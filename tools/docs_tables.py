@@ -12,6 +12,10 @@ shown in percent; ``M``: in millions; ``%SPEC``: Python's format SPEC, e.g. ``%+
 unit put after the number). The table is followed by the commands that produced it, so no figure is typed
 by hand. A missing file, a key no selected line has, or an empty selection fails the build; a key only some
 lines have reads "—" in the others.
+
+A learning curve (``make train`` writes ``docs/data/train/<name>.jsonl``: one line per evaluation, the last one
+the final evaluation) is asked for with ``<!-- curve NAME -->``: an SVG of success and collision rate against
+env steps, drawn here from those lines, and the final result under it.
 """
 
 from __future__ import annotations
@@ -27,7 +31,11 @@ from mkdocs.structure.files import Files
 from mkdocs.structure.pages import Page
 
 DATA = Path(__file__).resolve().parents[1] / "docs" / "data" / "bench"
+TRAIN = DATA.parent / "train"
 MARKER = re.compile(r"<!-- bench (?P<spec>[^|>]+)\|(?P<columns>[^>]+)-->")
+CURVE = re.compile(r"<!-- curve (?P<name>[\w-]+) -->")
+#: The curve's plot: size and margins in SVG pixels.
+WIDTH, HEIGHT, LEFT, RIGHT, TOP, BOTTOM = 640, 300, 56, 16, 16, 44
 
 
 def read_lines(name: str) -> list[dict[str, Any]]:
@@ -60,12 +68,16 @@ def number(value: float) -> str:
 
 
 def provenance(name: str) -> str:
-    """Which commands, run by which `make bench`, on what machine, made the file's lines."""
-    machine = json.loads((DATA / "machine.json").read_text())
-    make = "make bench QUICK=1" if machine["quick"] else "make bench"
+    """Which commands, run by which `make` target, on what machine, made the file's lines. A file measured by a
+    target of its own (``make bench-peers``) has its own ``<name>.machine.json``, with that target and a note
+    on the run; the others share ``machine.json`` of ``make bench``."""
+    own = DATA / f"{name}.machine.json"
+    machine = json.loads((own if own.is_file() else DATA / "machine.json").read_text())
+    make = machine.get("make") or ("make bench QUICK=1" if machine["quick"] else "make bench")
     commands = "; ".join(f"`{line}`" for line in (DATA / f"{name}.command").read_text().splitlines() if line)
+    note = f" ({machine['note']})" if machine.get("note") else ""
     return (f"*Measured by `{make}` on a {machine['cores']}-core machine ({machine['cpu']})"
-            f"{', short runs' if machine['quick'] else ''}: {commands}.*")
+            f"{', short runs' if machine['quick'] else ''}{note}: {commands}.*")
 
 
 def table(spec: str, columns: str) -> str:
@@ -85,5 +97,53 @@ def table(spec: str, columns: str) -> str:
     return head + body + "\n" + provenance(name) + "\n"
 
 
+def learning_curve(name: str) -> str:
+    """The SVG of the evaluations of ``TRAIN/<name>.jsonl`` and a line on the final one and its command."""
+    path = TRAIN / f"{name}.jsonl"
+    if not path.is_file():
+        raise PluginError(f"no learning curve {path}: run `make train`")
+    rows = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    points = [row for row in rows if not row.get("final")]
+    final = [row for row in rows if row.get("final")]
+    if not points or not final:
+        raise PluginError(f"learning curve {path}: needs periodic evaluations and a final one")
+    last = final[-1]
+    command = (TRAIN / f"{name}.command").read_text().strip()
+    return (curve_svg(points) + "\n\n"
+            f"*Final evaluation over {last['episodes']} unseen seeds: success {100 * last['success_rate']:.0f} %, "
+            f"collisions {100 * last['collision_rate']:.0f} %, after {last['env_steps']:,} env steps and "
+            f"{last['wall_s']:,.0f} s of wall time (evaluations included). Made by `make train`: `{command}`.*\n")
+
+
+def curve_svg(points: list[dict[str, Any]]) -> str:
+    """Success (solid) and collision rate (dashed) against env steps, axes 0–max steps and 0–100 %."""
+    span = max(row["env_steps"] for row in points)
+    plot_w, plot_h = WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM
+
+    def xy(steps: float, rate: float) -> str:
+        return f"{LEFT + plot_w * steps / span:.1f},{TOP + plot_h * (1 - rate):.1f}"
+
+    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {WIDTH} {HEIGHT}" width="{WIDTH}" '
+             f'height="{HEIGHT}" font-family="sans-serif" font-size="12" role="img" '
+             'aria-label="success and collision rate against env steps">']
+    for tick in (0.0, 0.25, 0.5, 0.75, 1.0):
+        y = TOP + plot_h * (1 - tick)
+        parts.append(f'<line x1="{LEFT}" y1="{y:.1f}" x2="{WIDTH - RIGHT}" y2="{y:.1f}" stroke="#ddd"/>'
+                     f'<text x="{LEFT - 6}" y="{y + 4:.1f}" text-anchor="end">{100 * tick:.0f} %</text>')
+    for k in range(5):
+        steps = span * k / 4
+        x = LEFT + plot_w * k / 4
+        parts.append(f'<text x="{x:.1f}" y="{HEIGHT - BOTTOM + 16}" text-anchor="middle">{steps / 1000:,.0f}k</text>')
+    parts.append(f'<text x="{LEFT + plot_w / 2:.1f}" y="{HEIGHT - 6}" text-anchor="middle">env steps</text>')
+    for key, style, label in (("success_rate", "", "success"), ("collision_rate", ' stroke-dasharray="5,4"',
+                                                                   "collisions")):
+        line = " ".join(xy(row["env_steps"], row[key]) for row in points)
+        parts.append(f'<polyline fill="none" stroke="currentColor" stroke-width="2"{style} points="{line}">'
+                     f"<title>{label}</title></polyline>")
+    parts.append("</svg>")
+    return "".join(parts)
+
+
 def on_page_markdown(markdown: str, page: Page, config: MkDocsConfig, files: Files) -> str:
+    markdown = CURVE.sub(lambda match: learning_curve(match["name"]), markdown)
     return MARKER.sub(lambda match: table(match["spec"], match["columns"]), markdown)

@@ -22,6 +22,8 @@ TINY = {
     "fidelity": ["--variants", "B", "--robot-worlds", "crowd_100", "--robot-seconds", "1"],
     "jump_chain": [],
     "raycast": [],
+    # The stage_sim rows only: the peers' venvs (make bench-peers) need not be there.
+    "rl_peers": ["--robots", "1", "2", "--seconds", "0.1", "--reps", "1", "--cases", "stage_sim env", "stage_sim core"],
     "simulate": ["--robots", "1", "2", "--seconds", "0.5"],
     "stageros": ["--seconds", "1"],
     "startup": ["--runs", "1"],

@@ -1,0 +1,381 @@
+"""stage_sim beside the 2D lidar simulators an RL user would also pick, on one scenario, one JSON line per case.
+
+The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-beam 180° 4 m lidar, in a
+30 × 30 m walled arena with 8 boxes (sides 0.3–1 m), dt 0.1 s, a uniformly random action (0–1 m/s,
+±π/2 rad/s) for every robot at every step; 1, 10 and 100 robots. Simulators and the API measured:
+
+* ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
+  obstacles scenario; episodes that end are reset (resets count in the time);
+* ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env);
+* ``navground env`` / ``navground world``: navground 0.7 through navground-learning's Gymnasium env (1
+  robot) or shared parallel env (10, 100), and its bare ``World`` (commands set, ``actuate``, every
+  agent's lidar updated);
+* ``irsim-x`` (C++ lidar) and ``ir-sim`` (pure Python): ``irsim.make`` of a YAML world, ``env.step``.
+
+The peers run in venvs of their own (``.venv-peers/<peer>``, made by ``make bench-peers`` from
+``benchmarks/peers/<peer>.lock``); a peer whose venv is missing is left out, so the stage_sim rows run
+anywhere. Each measurement is its own process pinned to one core (``taskset -c --core``), and the
+repetitions alternate between simulators (rep 1 of every case, then rep 2, …) so that load drifts hit all
+alike. Per case: ``agent_steps_per_s`` counts every robot of every step (each robot's lidar is cast at every
+step in all of them) and ``live_agent_steps_per_s`` only robots whose episode is running (the envs that end
+episodes); min and max over ``--reps``. ``lidar_sees_robots`` is probed, not assumed: a robot 1 m straight
+ahead of another must show in the middle beam of its scan.
+
+    .venv/bin/python benchmarks/rl_peers.py [--robots 1 10 100] [--seconds 3] [--reps 3] [--core 0]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+ARENA = 30.0
+BOXES = 8
+BOX_SIDES = (0.3, 1.0)
+RADIUS = 0.2
+BEAMS, FOV, RANGE = 512, math.pi, 4.0
+DT = 0.1
+V_MAX, W_MAX = 1.0, math.pi / 2
+#: Case → the venv (under --venvs) whose interpreter runs it; None: this interpreter (stage_sim's venv).
+CASES: dict[str, str | None] = {
+    "stage_sim env": None, "stage_sim core": None,
+    "navground env": "navground", "navground world": "navground",
+    "irsim-x": "irsim-x", "ir-sim": "ir-sim",
+}
+#: The probe of ``lidar_sees_robots``: robot 1 a metre straight ahead of robot 0, nothing else around.
+PROBE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+#: Steps run before the clock starts (compiled kernels loaded, first scans, caches warm).
+WARM_UP = 20
+#: Random actions drawn per run (then taken again from the first).
+ACTION_ROWS = 1000
+
+
+# -- the scenario, the same numbers for every simulator ------------------------------------------------
+
+def layout(robots: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes (8, 5: x, y, side x, side y, yaw) and robot poses (robots, 3) in an arena centred on 0, robots
+    clear of the boxes and of each other (rejection sampling from ``seed``)."""
+    rng = np.random.default_rng(seed)
+    half = ARENA / 2 - 1.0
+    boxes = np.column_stack([rng.uniform(-half, half, (BOXES, 2)), rng.uniform(*BOX_SIDES, (BOXES, 2)),
+                             rng.uniform(-math.pi, math.pi, BOXES)])
+    poses: list[tuple[float, float, float]] = []
+    while len(poses) < robots:
+        x, y = rng.uniform(-half, half, 2)
+        if (np.hypot(boxes[:, 0] - x, boxes[:, 1] - y).min() > 1.0
+                and all(math.hypot(px - x, py - y) > 4 * RADIUS for px, py, _ in poses)):
+            poses.append((x, y, rng.uniform(-math.pi, math.pi)))
+    return boxes, np.array(poses)
+
+
+def box_corners(box: np.ndarray) -> list[tuple[float, float]]:
+    """The four corners of a box (x, y, side x, side y, yaw), counter-clockwise."""
+    x, y, sx, sy, yaw = box
+    c, s = math.cos(yaw), math.sin(yaw)
+    return [(x + c * dx - s * dy, y + s * dx + c * dy)
+            for dx, dy in ((-sx / 2, -sy / 2), (sx / 2, -sy / 2), (sx / 2, sy / 2), (-sx / 2, sy / 2))]
+
+
+def actions(robots: int, steps: int, seed: int) -> np.ndarray:
+    """Random (forward speed, turn rate) per step and robot, drawn before the clock starts."""
+    rng = np.random.default_rng(seed + 1)
+    return np.stack([rng.uniform(0, V_MAX, (steps, robots)), rng.uniform(-W_MAX, W_MAX, (steps, robots))], -1)
+
+
+# -- one measurement per process ------------------------------------------------------------------------
+
+class Runner:
+    """One simulator at one size: ``step`` advances every robot once, returns how many were live."""
+
+    sees_robots: bool
+
+    def step(self, action: np.ndarray) -> int:
+        raise NotImplementedError
+
+
+class StageEnv(Runner):
+    def __init__(self, robots: int, seed: int) -> None:
+        from stage_sim.envs import NavigateEnv, NavigateParallelEnv
+
+        options = {"scenario": "obstacles", "n_obstacles": BOXES, "obstacle_size": BOX_SIDES,
+                   "arena_size": ARENA, "resolution": 0.05}
+        self.single = robots == 1
+        self.env = NavigateEnv(**options) if self.single else NavigateParallelEnv(n_robots=robots, **options)
+        self.env.reset(seed=seed)
+        self.sees_robots = stage_sees_robots()
+
+    def step(self, action: np.ndarray) -> int:
+        action = action.astype(np.float32)
+        if self.single:
+            _, _, terminated, truncated, _ = self.env.step(action[0])
+            if terminated or truncated:
+                self.env.reset()
+            return 1
+        if not self.env.agents:
+            self.env.reset()
+        live = len(self.env.agents)
+        index = {name: k for k, name in enumerate(self.env.possible_agents)}
+        self.env.step({agent: action[index[agent]] for agent in self.env.agents})
+        return live
+
+
+class StageCore(StageEnv):
+    """The env's world, stepped by ``Simulation.step`` alone: commands written into its array, one step."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        super().__init__(robots, seed)
+        self.sim = self.env.task.sim
+
+    def step(self, action: np.ndarray) -> int:
+        self.sim.commands[:, 0] = action[:, 0]
+        self.sim.commands[:, 2] = action[:, 1]
+        self.sim.step()
+        return len(action)
+
+
+def stage_sees_robots() -> bool:
+    from stage_sim.envs import NavigateParallelEnv
+
+    env = NavigateParallelEnv(scenario="random", n_robots=2, arena_size=ARENA)
+    env.reset(seed=0)
+    sim = env.task.sim
+    sim.set_pose(0, 0.0, 0.0, 0.0)
+    sim.set_pose(1, 1.0, 0.0, 0.0)
+    sim.step()
+    return bool(sim.scans[0][0].ranges[BEAMS // 2] < 0.9)
+
+
+def navground_yaml(boxes: np.ndarray, poses: np.ndarray, scenario: bool = False) -> str:
+    """A navground world (or, ``scenario``, a scenario of one-agent groups): arena and boxes as walls."""
+    half = ARENA / 2
+    square = [(-half, -half), (half, -half), (half, half), (-half, half)]
+    walls = [(a, b) for outline in [square, *map(box_corners, boxes)]
+             for a, b in zip(outline, outline[1:] + outline[:1], strict=True)]
+    lines = ["walls:"] + [f"  - line: [[{a[0]}, {a[1]}], [{b[0]}, {b[1]}]]" for a, b in walls]
+    lines.append("groups:" if scenario else "agents:")
+    for x, y, yaw in poses:
+        lines += ["  - type: ''", *(["    number: 1"] if scenario else []), f"    radius: {RADIUS}",
+                  f"    position: [{x}, {y}]", f"    orientation: {yaw}", f"    control_period: {DT}",
+                  "    behavior: {type: Dummy}",
+                  f"    kinematics: {{type: 2WDiff, max_speed: {V_MAX}, wheel_axis: {4 * RADIUS}}}",
+                  f"    state_estimation: {NAVGROUND_LIDAR}"]
+    return "\n".join(lines) + "\n"
+
+
+NAVGROUND_LIDAR = (f"{{type: Lidar, name: lidar, range: {RANGE}, start_angle: {-FOV / 2}, field_of_view: {FOV}, "
+                   f"resolution: {BEAMS}}}")
+
+
+class NavgroundWorld(Runner):
+    """The bare world: each agent's command set, ``World.actuate``, each agent's lidar updated into its state."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        from navground import core, sim
+
+        self.core = core
+        self.world = sim.load_world(navground_yaml(*layout(robots, seed)))
+        self.states = []
+        for agent in self.world.agents:
+            state = core.SensingState()
+            agent.state_estimation.prepare_state(state)
+            self.states.append(state)
+        self.sees_robots = navground_sees_robots()
+
+    def step(self, action: np.ndarray) -> int:
+        core = self.core
+        for agent, (v, w) in zip(self.world.agents, action, strict=True):
+            agent.last_cmd = core.Twist2((float(v), 0.0), float(w), frame=core.Frame.relative)
+        self.world.actuate(DT)
+        for agent, state in zip(self.world.agents, self.states, strict=True):
+            agent.state_estimation.update(agent, self.world, state)
+        return len(action)
+
+
+def navground_sees_robots() -> bool:
+    from navground import core, sim
+
+    world = sim.load_world(navground_yaml(np.empty((0, 5)), PROBE))
+    agent = world.agents[0]
+    state = core.SensingState()
+    agent.state_estimation.prepare_state(state)
+    agent.state_estimation.update(agent, world, state)
+    return bool(np.asarray(agent.state_estimation.read_ranges(state))[BEAMS // 2] < 0.9)
+
+
+class NavgroundEnv(Runner):
+    """navground-learning's envs: the Gymnasium env (1 robot) or the shared parallel env (every robot an agent),
+    actions in [-1, 1] scaled by the env to the robot's limits."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        import gymnasium
+        import navground.learning.env  # noqa: F401  (registers "navground")
+        from navground import sim
+        from navground.learning import ControlActionConfig, DefaultObservationConfig
+        from navground.learning.parallel_env import shared_parallel_env
+
+        scenario = sim.load_scenario(navground_yaml(*layout(robots, seed), scenario=True))
+        options = {"scenario": scenario, "sensor": NAVGROUND_LIDAR, "time_step": DT, "max_duration": 50.0,
+                   "terminate_if_idle": False,
+                   "action": ControlActionConfig(use_acceleration_action=False),
+                   "observation": DefaultObservationConfig(include_target_direction=False,
+                                                           include_target_distance=False)}
+        self.single = robots == 1
+        self.env = gymnasium.make("navground", **options) if self.single else shared_parallel_env(**options)
+        self.env.reset(seed=seed)
+        self.sees_robots = navground_sees_robots()
+
+    def step(self, action: np.ndarray) -> int:
+        scaled = np.column_stack([2 * action[:, 0] / V_MAX - 1, action[:, 1] / W_MAX]).astype(np.float32)
+        if self.single:
+            _, _, terminated, truncated, _ = self.env.step(scaled[0])
+            if terminated or truncated:
+                self.env.reset()
+            return 1
+        if not self.env.agents:
+            self.env.reset()
+        live = len(self.env.agents)
+        self.env.step({agent: scaled[agent] for agent in self.env.agents})
+        return live
+
+
+def irsim_yaml(boxes: np.ndarray, poses: np.ndarray) -> str:
+    """An ir-sim world: its frame runs from (0, 0) to (width, height), so everything moves by half the arena."""
+    shift = ARENA / 2
+    states = [[x + shift, y + shift, yaw] for x, y, yaw in poses]
+    robot = (f"  - number: {len(poses)}\n    distribution: {{name: manual}}\n    state: {json.dumps(states)}\n"
+             f"    kinematics: {{name: diff}}\n    shape: {{name: circle, radius: {RADIUS}}}\n"
+             f"    vel_min: [0, {-W_MAX}]\n    vel_max: [{V_MAX}, {W_MAX}]\n    sensors:\n"
+             f"      - {{name: lidar2d, range_min: 0, range_max: {RANGE}, angle_range: {FOV}, number: {BEAMS}}}\n")
+    obstacles = "".join(
+        f"  - number: 1\n    distribution: {{name: manual}}\n    state: [[{x + shift}, {y + shift}, {yaw}]]\n"
+        f"    shape: [{{name: rectangle, length: {sx}, width: {sy}}}]\n" for x, y, sx, sy, yaw in boxes)
+    return (f"world:\n  height: {ARENA}\n  width: {ARENA}\n  step_time: {DT}\n  sample_time: {DT}\n"
+            f"  collision_mode: stop\nrobot:\n{robot}" + (f"obstacle:\n{obstacles}" if obstacles else ""))
+
+
+class IrSim(Runner):
+    """ir-sim or irsim-x (both install the ``irsim`` module): ``env.step`` with every robot's action."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        self.env = irsim_env(irsim_yaml(*layout(robots, seed)), f"rl_peers_{robots}_{seed}")
+        self.ids = list(range(robots))
+        self.sees_robots = irsim_sees_robots()
+
+    def step(self, action: np.ndarray) -> int:
+        self.env.step(list(action.reshape(-1, 2, 1)), action_id=self.ids)
+        return len(action)
+
+
+def irsim_env(text: str, name: str) -> Any:
+    import tempfile
+
+    import irsim
+
+    path = Path(tempfile.mkdtemp()) / f"{name}.yaml"
+    path.write_text(text)
+    return irsim.make(str(path), display=False, disable_all_plot=True, log_level="WARNING")
+
+
+def irsim_sees_robots() -> bool:
+    env = irsim_env(irsim_yaml(np.empty((0, 5)), PROBE), "rl_peers_probe")
+    env.step([np.zeros((2, 1)), np.zeros((2, 1))], action_id=[0, 1])
+    return bool(np.asarray(env.robot_list[0].get_lidar_scan()["ranges"])[BEAMS // 2] < 0.9)
+
+
+RUNNERS: dict[str, type[Runner]] = {
+    "stage_sim env": StageEnv, "stage_sim core": StageCore, "navground env": NavgroundEnv,
+    "navground world": NavgroundWorld, "irsim-x": IrSim, "ir-sim": IrSim,
+}
+
+
+def measure(case: str, robots: int, seconds: float, seed: int) -> dict[str, Any]:
+    """Steps for ``seconds`` of wall time after the warm-up (building the world is not timed), the random
+    actions drawn beforehand and taken in turn."""
+    runner = RUNNERS[case](robots, seed)
+    commands = actions(robots, ACTION_ROWS, seed)
+    for action in commands[:WARM_UP]:
+        runner.step(action)
+    steps = live = 0
+    start = time.perf_counter()
+    while (elapsed := time.perf_counter() - start) < seconds:
+        live += runner.step(commands[steps % ACTION_ROWS])
+        steps += 1
+    return {"steps": steps, "agent_steps_per_s": robots * steps / elapsed, "live_agent_steps_per_s": live / elapsed,
+            "lidar_sees_robots": runner.sees_robots}
+
+
+# -- the driver: alternating processes, pinned ------------------------------------------------------------
+
+def interpreter(case: str, venvs: Path) -> Path | None:
+    """The Python that runs ``case``, or None when its peer's venv is not there."""
+    venv = CASES[case]
+    if venv is None:
+        return Path(sys.executable)
+    python = venvs / venv / "bin" / "python"
+    return python if python.is_file() else None
+
+
+def run_case(python: Path, case: str, robots: int, seconds: float, seed: int, core: int | None) -> dict[str, Any]:
+    command = [str(python), __file__, "--worker", case, "--robots", str(robots), "--seconds", str(seconds),
+               "--seed", str(seed)]
+    if core is not None and shutil.which("taskset"):
+        command = ["taskset", "-c", str(core), *command]
+    # stage_sim's compiled kernels from the first step (else it steps on numpy while numba loads).
+    env = {**os.environ, "PYTHONPATH": str(REPO), "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg",
+           "STAGE_SIM_KERNELS": "numba"}
+    done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"{case} with {robots} robots failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robots", type=int, nargs="+", default=[1, 10, 100])
+    parser.add_argument("--seconds", type=float, default=3.0, help="timed wall seconds per run")
+    parser.add_argument("--reps", type=int, default=3, help="runs per case, alternating between simulators")
+    parser.add_argument("--core", type=int, default=0, help="the core every run is pinned to (-1: no pinning)")
+    parser.add_argument("--venvs", type=Path, default=REPO / ".venv-peers", help="where the peers' venvs are")
+    parser.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES), metavar="CASE")
+    parser.add_argument("--worker", choices=list(CASES), help=argparse.SUPPRESS)
+    parser.add_argument("--seed", type=int, default=0, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        print(json.dumps(measure(args.worker, args.robots[0], args.seconds, args.seed)), flush=True)
+        return 0
+    pythons = {case: interpreter(case, args.venvs) for case in args.cases}
+    for case, python in pythons.items():
+        if python is None:
+            print(f"rl_peers: {case} left out: no {args.venvs / str(CASES[case])} (make bench-peers)", file=sys.stderr)
+    cases = [case for case, python in pythons.items() if python is not None]
+    core = None if args.core < 0 else args.core
+    for robots in args.robots:
+        runs: dict[str, list[dict[str, Any]]] = {case: [] for case in cases}
+        for rep in range(args.reps):
+            for case in cases:
+                runs[case].append(run_case(pythons[case], case, robots, args.seconds, rep, core))
+        for case in cases:
+            line: dict[str, Any] = {"bench": "rl_peers", "simulator": case, "robots": robots, "reps": args.reps,
+                                    "steps": min(run["steps"] for run in runs[case])}
+            for key in ("agent_steps_per_s", "live_agent_steps_per_s"):
+                values = [run[key] for run in runs[case]]
+                line[key] = f"{min(values):,.0f}–{max(values):,.0f}"
+                line[f"{key}_min"], line[f"{key}_max"] = round(min(values), 1), round(max(values), 1)
+            line["lidar_sees_robots"] = runs[case][0]["lidar_sees_robots"]
+            print(json.dumps(line), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

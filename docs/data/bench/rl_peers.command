@@ -1,0 +1,1 @@
+python benchmarks/rl_peers.py

@@ -1,0 +1,1 @@
+python examples/train_ppo.py
