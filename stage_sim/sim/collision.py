@@ -17,8 +17,9 @@ accepted one clears it; a robot with zero velocity is not touched (it keeps its 
 the moves just built (in Stage the sensors of update ``k + 1`` read layer ``k % 2``). The state is the
 pose of every robot in each layer (:attr:`Simulation._layer_poses`); this module is stateless.
 
-The numpy reference and the compiled backend (:mod:`stage_sim.sim.compiled`) share the decision order
-(:func:`decide_moves`, compiled there as it is) and differ in how the raster is computed, bit for bit the same.
+The numpy reference decides the moves from the pairs of robots sharing a cell (:func:`decide_moves`); the
+compiled backend (:mod:`stage_sim.sim.compiled`) replays them one by one as Stage does, comparing cells only
+between robots whose boxes meet, which needs no sorting. Both give the same answers, and the same raster bit for bit.
 """
 
 from __future__ import annotations
@@ -177,8 +178,8 @@ def shared_cells(cells: np.ndarray, owner: np.ndarray, other_cells: np.ndarray, 
 
 class CollisionChecker:
     """Decides which robot moves to accept, given the static cells that block each robot's height band: the
-    numpy reference of the :class:`Contact` role. The compiled backend overrides ``_raster``, ``_contains``
-    and ``_decide`` with the same answers."""
+    numpy reference of the :class:`Contact` role. The compiled backend overrides ``_integrate``, ``_raster``,
+    ``_static_hits`` and ``_decide`` with the same answers."""
 
     def __init__(
         self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
@@ -202,7 +203,7 @@ class CollisionChecker:
         refused here: the caller keeps their stall flag, as Stage does."""
         refused = np.zeros(len(poses), dtype=bool)
         candidates = poses.copy()
-        candidates[moving] = integrate(poses[moving], velocities[moving], dt)
+        candidates[moving] = self._integrate(poses[moving], velocities[moving], dt)
         testers = np.flatnonzero(moving & self._collides)
         if testers.size:
             cells, owner = self._raster(candidates, testers)
@@ -211,9 +212,8 @@ class CollisionChecker:
                 others = self._colliding
                 before = self._raster(layer_poses, others)
                 back = self._raster(poses, testers)
-                self._decide(testers, static_hit, shared_cells(cells, owner, *before, testers),
-                             shared_cells(cells, owner, cells, owner, testers),
-                             shared_cells(cells, owner, *back, testers), refused)
+                self._decide(testers, static_hit, (cells, owner), before, back, (candidates, layer_poses, poses),
+                             refused)
             else:
                 refused[testers] = static_hit[testers]
         final = np.where(refused[:, None], poses, candidates)
@@ -255,20 +255,27 @@ class CollisionChecker:
         inside = (cols >= 0) & (cols < w) & (rows >= 0) & (rows < h)
         return np.where(inside, rows * w + cols, -1), self._vertex_robot[vi][edge]
 
+    def _integrate(self, poses: np.ndarray, velocities: np.ndarray, dt: float) -> np.ndarray:
+        """The end poses of one step: :func:`~stage_sim.sim.kinematics.integrate`."""
+        return integrate(poses, velocities, dt)
+
     def _static_hits(self, cells: np.ndarray, owner: np.ndarray) -> np.ndarray:
         """Per robot: whether one of its cells (``cells``, ``owner``) is a static cell of its height band."""
         layer_index = self._layer_of_robot[owner]
         hit = np.zeros(len(cells), dtype=bool)
         for i, layer in enumerate(self._layers):
             use = (layer_index == i) & (cells >= 0)
-            hit[use] = self._contains(layer, cells[use])
+            hit[use] = layer.contains(cells[use])
         return np.bincount(owner[hit], minlength=self.bodies.count) > 0
 
-    def _contains(self, layer: TileLayer, cells: np.ndarray) -> np.ndarray:
-        """Whether each flat cell is in the static layer."""
-        return layer.contains(cells)
-
-    def _decide(self, testers: np.ndarray, static_hit: np.ndarray, before: tuple, cand: tuple, back: tuple,
-                refused: np.ndarray) -> None:
-        """:func:`decide_moves` (the compiled backend runs it compiled)."""
-        decide_moves(testers, static_hit, *before, *cand, *back, refused)
+    def _decide(self, testers: np.ndarray, static_hit: np.ndarray, cand: tuple, before: tuple, back: tuple,
+                poses: tuple, refused: np.ndarray) -> None:
+        """Set ``refused`` for the ``testers`` given the rasters (cells, robot) of their end poses (``cand``),
+        of the obstacle robots where the layer holds them (``before``) and of the testers' start poses
+        (``back``), and the poses of those three (end, layer, start): :func:`decide_moves` on the robots
+        sharing a cell. The compiled backend gets the same answers by replaying the moves one by one,
+        comparing cells only between robots whose boxes meet."""
+        cells, owner = cand
+        decide_moves(testers, static_hit, *shared_cells(cells, owner, *before, testers),
+                     *shared_cells(cells, owner, cells, owner, testers), *shared_cells(cells, owner, *back, testers),
+                     refused)

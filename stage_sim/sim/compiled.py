@@ -15,7 +15,7 @@ from types import ModuleType
 import numpy as np
 
 from stage_sim.backend import set_threads
-from stage_sim.maps.tiles import CellValues, TileLayer
+from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
 from stage_sim.sim import body_kernels, motion_kernels, ranger_kernels
 from stage_sim.sim.collision import CollisionChecker
@@ -35,8 +35,8 @@ def kernel(module: ModuleType, name: str, items: int, threads: int):
 
 
 class CompiledCollisionChecker(CollisionChecker):
-    """:class:`~stage_sim.sim.collision.CollisionChecker` with its raster, static look-ups and move decisions on
-    :mod:`stage_sim.sim.body_kernels`."""
+    """:class:`~stage_sim.sim.collision.CollisionChecker` with its end poses, raster, static look-ups and move
+    decisions on :mod:`stage_sim.sim.body_kernels` and :mod:`stage_sim.sim.motion_kernels`."""
 
     def _raster(self, poses: np.ndarray, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         g = self.grid
@@ -45,16 +45,33 @@ class CompiledCollisionChecker(CollisionChecker):
             b.vertices, b.poly_start, b.robot_poly, robots, poses[:, 0].copy(), poses[:, 1].copy(),
             np.cos(poses[:, 2]), np.sin(poses[:, 2]), 1.0 / g.resolution, *g.corner, *g.shape)
 
-    def _contains(self, layer: TileLayer, cells: np.ndarray) -> np.ndarray:
-        out = np.empty(cells.size, dtype=bool)
-        grid = layer.grid
-        body_kernels.layer_contains(cells, grid.slots, layer.tile_of_slot, layer.bits, grid.place, grid.shape[1],
-                                         out)
+    def _integrate(self, poses: np.ndarray, velocities: np.ndarray, dt: float) -> np.ndarray:
+        out = np.empty_like(poses)
+        motion_kernels.integrate_poses(poses, velocities, dt, np.cos(poses[:, 2]), np.sin(poses[:, 2]), out)
         return out
 
-    def _decide(self, testers: np.ndarray, static_hit: np.ndarray, before: tuple, cand: tuple, back: tuple,
-                refused: np.ndarray) -> None:
-        body_kernels.decide(testers, static_hit, *before, *cand, *back, refused)
+    def _static_hits(self, cells: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        hit = np.zeros(self.bodies.count, dtype=bool)
+        for i, layer in enumerate(self._layers):
+            grid = layer.grid
+            body_kernels.static_hits(cells, owner, self._layer_of_robot, i, grid.slots, layer.tile_of_slot,
+                                     layer.bits, grid.place, grid.shape[1], hit)
+        return hit
+
+    def _decide(self, testers: np.ndarray, static_hit: np.ndarray, cand: tuple, before: tuple, back: tuple,
+                poses: tuple, refused: np.ndarray) -> None:
+        candidates, layer_poses, start_poses = poses
+        box = np.stack([self._boxes(p) for p in (layer_poses, candidates, start_poses)])
+        body_kernels.move_one_by_one(testers, static_hit, *cand, *before, *back, self._colliding, box, refused)
+
+    def _boxes(self, poses: np.ndarray) -> np.ndarray:
+        """(col min, row min, col max, row max) world cells holding each robot's raster at ``poses``: its
+        farthest vertex around the pose, a cell more on each side for the rounding."""
+        ppm = 1.0 / self.grid.resolution
+        reach = self.bodies.radius[:, None]
+        low = np.floor((poses[:, :2] - reach) * ppm) - 1
+        high = np.floor((poses[:, :2] + reach) * ppm) + 1
+        return np.concatenate([low, high], axis=1).astype(np.int64)
 
 
 class CompiledMotion:
