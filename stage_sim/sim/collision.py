@@ -123,7 +123,7 @@ def decide_moves(testers, static_hit, before_start, before_other, cand_start, ca
     when ``i`` moves. Per tester k, ``*_other[*_start[k]:*_start[k + 1]]`` are the robots sharing a cell with
     its end pose: at their layer pose (``before``: valid for robots not moved yet in this update), at their
     own end pose (``cand``: valid for earlier testers that moved) or back at their start pose (``back``:
-    earlier testers that were refused). Plain loops: :mod:`stage_sim.sim.body_kernels` compiles this."""
+    earlier testers that were refused)."""
     n = refused.size
     tester = np.zeros(n, dtype=np.bool_)
     for k in range(testers.size):
