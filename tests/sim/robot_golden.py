@@ -4,8 +4,8 @@
 they were recorded) holds, per world, every robot's first scan with all robots standing at their start
 poses (``<world>_scans.jsonl``) and every robot's true pose and stall flag each second while all of them
 drive circles at 0.3 m/s, 0.5 rad/s (``<world>_traj.jsonl``). Rows are keyed by start pose: Stage's model
-order is not the file's. ``crowd_100_seed11`` is held out: made by ``tools/held_out_worlds.py`` and recorded
-the same way, after the rules here were settled (other held-out recordings can be replayed from their folder).
+order is not the file's. ``crowd_100_seed11``, ``crowd_1000_seed12`` and ``discs_200_seed13`` are held out:
+made by ``tools/held_out_worlds.py`` and recorded the same way, after the rules here were settled.
 """
 
 from __future__ import annotations
@@ -21,7 +21,8 @@ from stage_sim.worldfile.loader import load_world
 
 ROBOTS = Path(__file__).resolve().parents[2] / "tests" / "data" / "fidelity" / "robots"
 #: The recorded worlds: (name, seconds driven).
-WORLDS = {"crowd_100": 30, "crowd_1000": 10, "discs_200": 20, "crowd_100_seed11": 30}
+WORLDS = {"crowd_100": 30, "crowd_1000": 10, "discs_200": 20, "crowd_100_seed11": 30, "discs_200_seed13": 20,
+          "crowd_1000_seed12": 10}
 SPEED = (0.3, 0.0, 0.5)
 #: A pose closer to Stage's than this is on Stage's path; a range closer than this is identical.
 SAME = 1e-3
