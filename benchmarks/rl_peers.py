@@ -34,6 +34,7 @@ import shutil
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -104,7 +105,28 @@ class Runner:
         raise NotImplementedError
 
 
-class StageEnv(Runner):
+class EnvRunner(Runner):
+    """A Gymnasium env (one robot; reset when its episode ends) or a PettingZoo parallel env (reset when no
+    agent is left): ``step`` hands each live agent its row of the actions."""
+
+    env: Any
+    single: bool
+
+    def step_env(self, rows: np.ndarray, row_of: Callable[[Any], int]) -> int:
+        """One step with the actions ``rows`` (robot, 2) in the env's own units; agent → row by ``row_of``."""
+        if self.single:
+            _, _, terminated, truncated, _ = self.env.step(rows[0])
+            if terminated or truncated:
+                self.env.reset()
+            return 1
+        if not self.env.agents:
+            self.env.reset()
+        live = len(self.env.agents)
+        self.env.step({agent: rows[row_of(agent)] for agent in self.env.agents})
+        return live
+
+
+class StageEnv(EnvRunner):
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.envs import NavigateEnv, NavigateParallelEnv
 
@@ -112,22 +134,12 @@ class StageEnv(Runner):
                    "arena_size": ARENA, "resolution": 0.05}
         self.single = robots == 1
         self.env = NavigateEnv(**options) if self.single else NavigateParallelEnv(n_robots=robots, **options)
+        self.row_of = int if self.single else {name: k for k, name in enumerate(self.env.possible_agents)}.__getitem__
         self.env.reset(seed=seed)
         self.sees_robots = stage_sees_robots()
 
     def step(self, action: np.ndarray) -> int:
-        action = action.astype(np.float32)
-        if self.single:
-            _, _, terminated, truncated, _ = self.env.step(action[0])
-            if terminated or truncated:
-                self.env.reset()
-            return 1
-        if not self.env.agents:
-            self.env.reset()
-        live = len(self.env.agents)
-        index = {name: k for k, name in enumerate(self.env.possible_agents)}
-        self.env.step({agent: action[index[agent]] for agent in self.env.agents})
-        return live
+        return self.step_env(action.astype(np.float32), self.row_of)
 
 
 class StageCore(StageEnv):
@@ -213,7 +225,7 @@ def navground_sees_robots() -> bool:
     return bool(np.asarray(agent.state_estimation.read_ranges(state))[BEAMS // 2] < 0.9)
 
 
-class NavgroundEnv(Runner):
+class NavgroundEnv(EnvRunner):
     """navground-learning's envs: the Gymnasium env (1 robot) or the shared parallel env (every robot an agent),
     actions in [-1, 1] scaled by the env to the robot's limits."""
 
@@ -237,16 +249,7 @@ class NavgroundEnv(Runner):
 
     def step(self, action: np.ndarray) -> int:
         scaled = np.column_stack([2 * action[:, 0] / V_MAX - 1, action[:, 1] / W_MAX]).astype(np.float32)
-        if self.single:
-            _, _, terminated, truncated, _ = self.env.step(scaled[0])
-            if terminated or truncated:
-                self.env.reset()
-            return 1
-        if not self.env.agents:
-            self.env.reset()
-        live = len(self.env.agents)
-        self.env.step({agent: scaled[agent] for agent in self.env.agents})
-        return live
+        return self.step_env(scaled, int)  # its agents are their indices
 
 
 def irsim_yaml(boxes: np.ndarray, poses: np.ndarray) -> str:

@@ -21,6 +21,14 @@ _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 walk = numba.njit(**_JIT)(edge_walk)
 
 
+@numba.njit(inline="always", **_JIT)
+def _floored_vertices(vertices, a, b, x, y, cos, sin, ppm, out):
+    """``out[:b - a]``: the world cells of vertices ``a`` to ``b`` placed at (x, y) facing (cos, sin)."""
+    for v in range(a, b):
+        out[v - a, 0] = math.floor((x + cos * vertices[v, 0] - sin * vertices[v, 1]) * ppm)
+        out[v - a, 1] = math.floor((y + sin * vertices[v, 0] + cos * vertices[v, 1]) * ppm)
+
+
 @numba.njit(**_JIT)
 def body_raster(vertices, poly_start, robot_poly, robots, x, y, cos, sin, ppm, col0, row0, height, width):
     """(flat cell or −1 off the grid, robot) of every cell of the bodies of ``robots`` placed at (x, y) facing
@@ -36,9 +44,7 @@ def body_raster(vertices, poly_start, robot_poly, robots, x, y, cos, sin, ppm, c
         r = robots[k]
         for p in range(robot_poly[r], robot_poly[r + 1]):
             a, b = poly_start[p], poly_start[p + 1]
-            for v in range(a, b):
-                scratch[v - a, 0] = math.floor((x[r] + cos[r] * vertices[v, 0] - sin[r] * vertices[v, 1]) * ppm)
-                scratch[v - a, 1] = math.floor((y[r] + sin[r] * vertices[v, 0] + cos[r] * vertices[v, 1]) * ppm)
+            _floored_vertices(vertices, a, b, x[r], y[r], cos[r], sin[r], ppm, scratch)
             for v in range(b - a):
                 w = v + 1 if v + 1 < b - a else 0
                 total += abs(scratch[w, 0] - scratch[v, 0]) + abs(scratch[w, 1] - scratch[v, 1])
@@ -49,9 +55,7 @@ def body_raster(vertices, poly_start, robot_poly, robots, x, y, cos, sin, ppm, c
         r = robots[k]
         for p in range(robot_poly[r], robot_poly[r + 1]):
             a, b = poly_start[p], poly_start[p + 1]
-            for v in range(a, b):
-                scratch[v - a, 0] = math.floor((x[r] + cos[r] * vertices[v, 0] - sin[r] * vertices[v, 1]) * ppm)
-                scratch[v - a, 1] = math.floor((y[r] + sin[r] * vertices[v, 0] + cos[r] * vertices[v, 1]) * ppm)
+            _floored_vertices(vertices, a, b, x[r], y[r], cos[r], sin[r], ppm, scratch)
             m = walk(scratch[:b - a], cells, n)
             owner[n:m] = r
             n = m
