@@ -15,6 +15,7 @@ draws come from the caller's generator.
 
 from __future__ import annotations
 
+import copy
 import itertools
 
 import numpy as np
@@ -38,23 +39,64 @@ class FreeSpace:
     def __init__(self, sim: Simulation, robots: list[int], margin: float) -> None:
         static = sim.static
         static.grid.check_dense("placing robots in free space (a distance transform of the whole world)")
-        blocked = np.zeros(static.shape, dtype=bool)
-        for band in {sim.robots[i].z_band for i in robots}:
-            blocked |= static.filled_collision_layer(*band)
-        padded = np.pad(blocked, 1, constant_values=True)
+        self._robots = robots
+        self._margin = margin
+        self._blocked = self._blocked_of(sim)
+        padded = np.pad(self._blocked, 1, constant_values=True)
         clearance = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution
         self.radius = max(sim.robots[i].radius for i in robots)
-        valid = clearance > self.radius + margin + static.resolution
-        self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
-        self.cells = np.flatnonzero(valid)
-        labels = self.regions.ravel()[self.cells]
-        order = np.argsort(labels, kind="stable")
-        ends = np.searchsorted(labels[order], np.arange(1, count + 2))
-        self._region_cells = [self.cells[order[a:b]] for a, b in itertools.pairwise(ends)]
-        """The valid cells of region r at index r - 1, in increasing order."""
+        self._reach = self.radius + margin + static.resolution
+        """A valid centre is farther than this (m) from every blocking cell."""
         self.resolution = static.resolution
         self.origin = np.asarray(static.origin_xy, dtype=np.float64)
         self.width = static.shape[1]
+        self._index(clearance > self._reach)
+
+    def with_world(self, sim: Simulation) -> FreeSpace:
+        """The free space of ``sim``, whose world is this one's with more static bodies (an episode's
+        obstacles): only the cells near the new bodies are looked at again, with the same distances and
+        comparison as the whole-world transform, so the answer is the one a new :class:`FreeSpace` gives.
+        A world that differs otherwise (another grid, a body gone) gets a new FreeSpace."""
+        static = sim.static
+        same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
+                     and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
+        blocked = self._blocked_of(sim) if same_grid else None
+        if blocked is None or (self._blocked & ~blocked).any():
+            return FreeSpace(sim, self._robots, self._margin)
+        added = blocked & ~self._blocked
+        valid = self._valid.copy()
+        pad = int(self._reach / self.resolution) + 1
+        groups, _ = ndimage.label(added)
+        for rows, cols in ndimage.find_objects(groups):
+            window = (slice(max(rows.start - pad, 0), rows.stop + pad),
+                      slice(max(cols.start - pad, 0), cols.stop + pad))
+            clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
+            valid[window] &= clearance > self._reach
+        space = copy.copy(self)
+        space._blocked = blocked
+        space._index(valid)
+        return space
+
+    def _blocked_of(self, sim: Simulation) -> np.ndarray:
+        """Cells no part of a robot may cover: the filled bodies of every height band of the robots."""
+        blocked = np.zeros(sim.static.shape, dtype=bool)
+        for band in {sim.robots[i].z_band for i in self._robots}:
+            blocked |= sim.static.filled_collision_layer(*band)
+        return blocked
+
+    def _index(self, valid: np.ndarray) -> None:
+        """Regions and cells of the valid centres ``valid`` (a grid of bools)."""
+        self._valid = valid
+        self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
+        self.cells = np.flatnonzero(valid)
+        if count == 1:  # the common case needs no sorting by region
+            self._region_cells = [self.cells]
+        else:
+            labels = self.regions.ravel()[self.cells]
+            order = np.argsort(labels, kind="stable")
+            ends = np.searchsorted(labels[order], np.arange(1, count + 2))
+            self._region_cells = [self.cells[order[a:b]] for a, b in itertools.pairwise(ends)]
+        """The valid cells of region r at index r - 1, in increasing order."""
         if self.cells.size == 0:
             raise PlacementError(f"no free space wide enough for a robot of radius {self.radius:.2f} m")
 

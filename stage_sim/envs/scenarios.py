@@ -74,6 +74,7 @@ class Scenario:
         self.base = description
         self._base_space: FreeSpace | None = None
         self._space: tuple[Simulation, FreeSpace] | None = None
+        self._root_space: FreeSpace | None = None
 
     @property
     def changes_world(self) -> bool:
@@ -100,9 +101,13 @@ class Scenario:
         """Start poses (A, 3) and goals (A, 2) of the agents; other robots stay where the world put them."""
         if self.options.scenario == "circle":
             return self._circle(len(agents), rng)
-        if self._space is None or self._space[0] is not sim:
-            # The static world of a simulation never changes: its free space is worked out once.
+        if self._space is None:
             self._space = (sim, FreeSpace(sim, agents, self.options.clearance))
+            self._root_space = self._space[1]
+        elif self._space[0] is not sim:
+            # The static world of a simulation never changes: its free space is worked out once; an episode's
+            # world is the first one (the base, which check_room places in) with obstacles added.
+            self._space = (sim, self._root_space.with_world(sim))
         space = self._space[1]
         others = np.array([r.start[:2] for r in sim.robots if r.index not in agents]).reshape(-1, 2)
         return space.starts_and_goals(rng, len(agents), others, self.options.min_goal_distance)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from stage_sim.envs import RobotBody
-from stage_sim.envs.free_space import PlacementError
+from stage_sim.envs.free_space import FreeSpace, PlacementError
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
 from stage_sim.maps.polygon_raster import outline_points
@@ -73,6 +73,25 @@ def test_a_thousand_resets_with_fresh_obstacles() -> None:
         sim = Simulation(scenario.world(rng, base), kernels="numba")
         starts, goals = scenario.place(sim, [0], rng)
         check(sim, [0], starts, goals)
+
+
+@pytest.mark.parametrize("margin", [0.0, 0.1])
+def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obstacles(margin: float) -> None:
+    # What with_world saves (a distance transform of the whole world per episode) must change no answer.
+    scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=12, body=SMALL))
+    base = Simulation(scenario.base, kernels="numba")
+    root = FreeSpace(base, [0], margin)
+    for seed in range(100):
+        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels="numba")
+        derived, fresh = root.with_world(sim), FreeSpace(sim, [0], margin)
+        assert derived.cells.size < root.cells.size
+        np.testing.assert_array_equal(derived.regions, fresh.regions)
+        np.testing.assert_array_equal(derived.cells, fresh.cells)
+        assert len(derived._region_cells) == len(fresh._region_cells)
+        for mine, theirs in zip(derived._region_cells, fresh._region_cells, strict=True):
+            np.testing.assert_array_equal(mine, theirs)
+    # a world that lost a body of the base is worked out anew
+    assert np.array_equal(fresh.with_world(base).cells, root.cells)
 
 
 def test_the_env_resets_on_every_seed_that_failed_before() -> None:
