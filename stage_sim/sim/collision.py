@@ -176,6 +176,10 @@ def shared_cells(cells: np.ndarray, owner: np.ndarray, other_cells: np.ndarray, 
     return start, b_owner.astype(np.int64)
 
 
+RECENT_RASTERS = 4
+"""Rasters of every robot a checker keeps: the ones an update asks for again (see ``_raster_of``)."""
+
+
 class CollisionChecker:
     """Decides which robot moves to accept, given the static cells that block each robot's height band: the
     numpy reference of the :class:`Contact` role. The compiled backend overrides ``_integrate``, ``_raster``,
@@ -195,6 +199,8 @@ class CollisionChecker:
         self._everyone = np.arange(bodies.count, dtype=np.int64)
         self._vertex_robot = bodies.vertex_robot
         self._next_vertex = bodies.next_vertex
+        self._recent: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        """Rasters of every robot by the bytes of their poses, oldest first (:meth:`_raster_of`)."""
 
     def resolve(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, dt: float,
                 moving: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -202,16 +208,20 @@ class CollisionChecker:
         ``layer_poses``; returns (new poses, refused, the layer's new poses). Robots not moving are not
         refused here: the caller keeps their stall flag, as Stage does."""
         refused = np.zeros(len(poses), dtype=bool)
-        candidates = poses.copy()
-        candidates[moving] = self._integrate(poses[moving], velocities[moving], dt)
-        testers = np.flatnonzero(moving & self._collides)
+        if moving.all():  # the common case, without the fancy indexing
+            candidates = self._integrate(poses, velocities, dt)
+            testers = self._colliding
+        else:
+            candidates = poses.copy()
+            candidates[moving] = self._integrate(poses[moving], velocities[moving], dt)
+            testers = np.flatnonzero(moving & self._collides)
         if testers.size:
-            cells, owner = self._raster(candidates, testers)
+            cells, owner = self._raster_of(candidates, testers)
             static_hit = self._static_hits(cells, owner)
             if self._robots_can_clash:
                 others = self._colliding
-                before = self._raster(layer_poses, others)
-                back = self._raster(poses, testers)
+                before = self._raster_of(layer_poses, others)
+                back = self._raster_of(poses, testers)
                 self._decide(testers, static_hit, (cells, owner), before, back, (candidates, layer_poses, poses),
                              refused)
             else:
@@ -235,7 +245,22 @@ class CollisionChecker:
 
     def raster(self, poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(flat cell, robot) of every body cell with the robots at ``poses`` (N, 3); cell −1 off the grid."""
-        return self._raster(poses, self._everyone)
+        return self._raster_of(poses, self._everyone)
+
+    def _raster_of(self, poses: np.ndarray, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_raster`, remembered for the last few sets of poses of every robot: an update asks for the
+        poses the layer last saw (the rays' raster of two updates ago), the start poses (last update's end
+        poses) and, for the rays, the end poses it has just tested; stalled robots ask for the same ones
+        again and again. The arrays are shared, never changed."""
+        if robots.size != self.bodies.count:
+            return self._raster(poses, robots)
+        key = poses.tobytes()
+        found = self._recent.get(key)
+        if found is None:
+            found = self._recent[key] = self._raster(poses, robots)
+            if len(self._recent) > RECENT_RASTERS:
+                del self._recent[next(iter(self._recent))]
+        return found
 
     def _raster(self, poses: np.ndarray, robots: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`raster` of ``robots`` (ascending) only, robot by robot, polygon by polygon, edge by edge."""
