@@ -124,13 +124,11 @@ def _neighbours(box, robots):
             fill = start[:n].copy()
         for a in range(order.size):
             ra = order[a]
-            if box[ra, 0] > box[ra, 2]:
-                continue
             for b in range(a + 1, order.size):
                 rb = order[b]
                 if box[rb, 0] > box[ra, 2]:
                     break
-                if box[rb, 0] <= box[rb, 2] and _meet(box[ra], box[rb]):
+                if _meet(box[ra], box[rb]):
                     if twice:
                         other[fill[ra]] = rb
                         other[fill[rb]] = ra

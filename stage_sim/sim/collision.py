@@ -15,7 +15,8 @@ in this update at their new pose, the others where that layer last saw them (two
 move every update). A refused move puts the robot back (re-rasterised there) and sets its stall flag; an
 accepted one clears it; a robot with zero velocity is not touched (it keeps its flag). Rays read the layer
 the moves just built (in Stage the sensors of update ``k + 1`` read layer ``k % 2``). The state is the
-pose of every robot in each layer (:attr:`Simulation._layer_poses`); this module is stateless.
+pose of every robot in each layer (:attr:`Simulation._layer_poses`); a checker keeps only the last few
+rasters it made, which the same poses give again.
 
 The numpy reference decides the moves from the pairs of robots sharing a cell (:func:`decide_moves`); the
 compiled backend (:mod:`stage_sim.sim.compiled`) replays them one by one as Stage does, comparing cells only
