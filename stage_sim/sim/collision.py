@@ -177,7 +177,7 @@ def shared_cells(cells: np.ndarray, owner: np.ndarray, other_cells: np.ndarray, 
     return start, b_owner.astype(np.int64)
 
 
-RECENT_RASTERS = 4
+RECENT_RASTERS = 3
 """Rasters of every robot a checker keeps: the ones an update asks for again (see ``_raster_of``)."""
 
 
