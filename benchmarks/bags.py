@@ -8,8 +8,10 @@ one JSON object per line:
 - ``overhead``: rooms.world with one robot driven straight and by the wanderer for ``--duration`` sim seconds,
   and 100 robots for ``--crowd-duration``, plain and with ``--bag``, ``--repeat`` times each (interleaved; the
   best counts, as the machine is shared): sim seconds per wall second of each and ``cost_pct``, how much
-  slower the recording run is (the target: <= 15); ``cpu_cost_pct``, the same from the processes' CPU
-  seconds (both threads), which the load of other processes disturbs less.
+  slower the recording run is (the target: <= 15); ``cpu_cost_pct``, the same from the CPU seconds of the
+  processes (the simulator and its bag writer), which the load of other processes disturbs less;
+  ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports, loading the
+  world, and with a bag starting its writer process), which the rates leave out.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
   LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
 """
@@ -23,6 +25,7 @@ import resource
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 from mcap.reader import make_reader
@@ -43,11 +46,14 @@ def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict
     if bag is not None:
         command += ["--bag", str(bag)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.monotonic()
     result = subprocess.run(command, capture_output=True, text=True, check=True)
+    process_s = time.monotonic() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     sim_s, wall_s = map(float, RATE.search(result.stdout).groups())
     cpu_s = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
-    out = {"sim_s": sim_s, "wall_s": wall_s, "sim_rate": round(sim_s / wall_s, 2), "cpu_s": cpu_s}
+    out = {"sim_s": sim_s, "wall_s": wall_s, "sim_rate": round(sim_s / wall_s, 2), "cpu_s": cpu_s,
+           "setup_s": process_s - wall_s}
     if bag is not None:
         with bag.open("rb") as stream:
             reader = make_reader(stream)
@@ -75,6 +81,8 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
         "cost_pct": round(100 * (1 - recorded["sim_rate"] / plain["sim_rate"]), 1),
         "cpu_s_plain": round(cpu_plain, 2), "cpu_s_bag": round(cpu_bag, 2),
         "cpu_cost_pct": round(100 * (cpu_bag / cpu_plain - 1), 1),
+        "setup_s_plain": round(min(r["setup_s"] for r in plains), 2),
+        "setup_s_bag": round(min(r["setup_s"] for r in bags), 2),
         "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}
 
 

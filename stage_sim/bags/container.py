@@ -27,12 +27,15 @@ from typing import Any, TypeVar
 
 import foxglove
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
-from rosbags.typesys.store import Typestore
+from rosbags.typesys import Stores, get_typestore
 
 from stage_sim.bags.errors import BAG_SUFFIX, BagError
 from stage_sim.bags.topics import Topic, yaml_text
 
 _T = TypeVar("_T")
+
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+"""ROS 2 Jazzy's message definitions: the schemas and type hashes a bag names, the serialiser of its messages."""
 
 CHUNK_BYTES = 1024 * 1024
 """Uncompressed bytes per chunk at most (the mcap and rosbag2 default)."""
@@ -121,7 +124,7 @@ class _File:
 class McapBag:
     """An open bag: register the topics once, then :meth:`write` messages; :meth:`finish` writes the index."""
 
-    def __init__(self, path: Path, topics: list[Topic], typestore: Typestore, speedup: float = 0.0) -> None:
+    def __init__(self, path: Path, topics: list[Topic], speedup: float = 0.0) -> None:
         """Create ``path`` (replacing a file there) and write its header and rosbag2 metadata; ``speedup`` is the
         run's (``<= 0``: not paced, chunks close by size only).
 
@@ -147,10 +150,10 @@ class McapBag:
         schemas: dict[str, foxglove.Schema] = {}
         for topic in topics:
             if topic.msgtype not in schemas:
-                text, _ = typestore.generate_msgdef(topic.msgtype, ros_version=2)
+                text, _ = TYPESTORE.generate_msgdef(topic.msgtype, ros_version=2)
                 schemas[topic.msgtype] = foxglove.Schema(name=topic.msgtype, encoding="ros2msg", data=text.encode())
             metadata = {"offered_qos_profiles": topic.offered_qos_profiles(),
-                        "topic_type_hash": typestore.hash_rihs01(topic.msgtype)}
+                        "topic_type_hash": TYPESTORE.hash_rihs01(topic.msgtype)}
             self._channels[topic.name] = foxglove.Channel(topic.name, schema=schemas[topic.msgtype],
                                                           message_encoding="cdr", context=self._context,
                                                           metadata=metadata)

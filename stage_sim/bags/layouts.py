@@ -16,12 +16,15 @@ from __future__ import annotations
 
 import struct
 from abc import ABC, abstractmethod
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from stage_sim.interface import fields
 from stage_sim.interface.topics import Endpoint
+
+if TYPE_CHECKING:
+    from stage_sim.bags.step_state import PackedScans
 
 HEADER = 4
 """Bytes of the CDR encapsulation header: alignment counts from here."""
@@ -57,7 +60,12 @@ class Layout(ABC):
     """One endpoint's message: its template bytes and how a step's values refill them."""
 
     def __init__(self, template: bytes) -> None:
+        self._template = template
         self._buffer = bytearray(template)
+
+    def __reduce__(self) -> tuple[type[Layout], tuple[bytes]]:
+        """Pickled as its template (the writer process rebuilds the views into its own buffer)."""
+        return type(self), (self._template,)
 
     @staticmethod
     def prepare(values: Any) -> Any:
@@ -120,13 +128,12 @@ class ScanLayout(Layout):
         self._ranges = np.frombuffer(self._buffer, np.float32, self._beams, count + 4)
         self._intensities = np.frombuffer(self._buffer, np.float32, self._beams, count + 8 + 4 * self._beams)
 
-    def refill(self, values: fields.LatestScans, endpoint: Endpoint, sim_time_us: int) -> bytes | None:
+    def refill(self, values: PackedScans, endpoint: Endpoint, sim_time_us: int) -> bytes | None:
         scan = values.measured(endpoint.robot, endpoint.ranger)
         if scan is None:
             return None
         _stamp(self._buffer, HEADER, sim_time_us)
-        self._ranges[:] = scan.ranges  # cast to float32 as fields.scan_arrays does
-        self._intensities[:] = scan.intensities
+        self._ranges[:], self._intensities[:] = scan  # float32 already, as fields.scan_arrays makes them
         return bytes(self._buffer)
 
 

@@ -4,31 +4,32 @@ rosbags rather than mcap-ros2-support: its type store ships the Jazzy definition
 generates the ros2msg schema text and RIHS01 type hashes rosbag2 records, and serialises numpy arrays
 without a Python loop per element (about 10 µs for a 240-beam scan).
 
-The stepping thread only takes a :class:`StepState` (a few array copies); the messages are made on the bag's
-writer thread. The topics and their values come from the interface registry (:mod:`stage_sim.interface.topics`),
-the one the ROS layer publishes from; this module holds one message filler per topic, as
-:mod:`stage_sim.ros.topic_messages` does for rclpy. The latched messages are filled and serialised by rosbags;
-the per-step ones are serialised by rosbags once per endpoint (:func:`template`) and then refilled in those
-bytes (:mod:`stage_sim.bags.layouts`), which costs a fraction of a serialisation.
+The stepping side only copies a step's values (:class:`~stage_sim.bags.step_state.StepBatch`); the
+per-step messages are made in the bag's writer process (:mod:`stage_sim.bags.writer`). The topics and their
+values come from the interface registry (:mod:`stage_sim.interface.topics`), the one the ROS layer publishes
+from; this module holds one message filler per topic, as :mod:`stage_sim.ros.topic_messages` does for rclpy.
+The latched messages are filled and serialised by rosbags; the per-step ones are serialised by rosbags once
+per endpoint (:func:`template`) and then refilled in those bytes (:mod:`stage_sim.bags.layouts`), which costs
+a fraction of a serialisation.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import asdict, dataclass
+from collections.abc import Iterator, Sequence
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
-from rosbags.typesys import Stores, get_typestore
 
+from stage_sim.bags.container import TYPESTORE
 from stage_sim.bags.layouts import BoolLayout, ClockLayout, Layout, OdometryLayout, ScanLayout, TransformsLayout
+from stage_sim.bags.step_messages import StepChannel, StepMessages
 from stage_sim.bags.topics import Topic as RecordedTopic
 from stage_sim.interface import fields, frames, topics
 from stage_sim.interface.names import RobotNames
 from stage_sim.interface.topics import Endpoint, Timing, Topic, TopicMessage
 from stage_sim.sim.simulation import Simulation
 
-TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 _T = TYPESTORE.types
 Time, Header = _T["builtin_interfaces/msg/Time"], _T["std_msgs/msg/Header"]
 Vector3, Quaternion = _T["geometry_msgs/msg/Vector3"], _T["geometry_msgs/msg/Quaternion"]
@@ -41,32 +42,6 @@ Clock, TFMessage = _T["rosgraph_msgs/msg/Clock"], _T["tf2_msgs/msg/TFMessage"]
 OccupancyGridMsg, MapMetaData = _T["nav_msgs/msg/OccupancyGrid"], _T["nav_msgs/msg/MapMetaData"]
 
 _NO_COVARIANCE = np.zeros(36, dtype=np.float64)
-
-
-def _owned(value: Any) -> Any:
-    """A topic's values, safe to keep while the simulation steps on (arrays copied, scans snapshotted)."""
-    if isinstance(value, np.ndarray):
-        return value.copy()
-    if isinstance(value, tuple):
-        return tuple(_owned(v) for v in value)
-    if isinstance(value, fields.LatestScans):
-        return value.snapshot()
-    return value
-
-
-@dataclass(frozen=True)
-class StepState:
-    """What one step publishes, copied off the simulation so the writer thread can build it later."""
-
-    sim_time_us: int
-    values: list[Any]
-    """The values (:attr:`Topic.values`) of the per-step topics it was captured for, in their order (a list,
-    not a dict by topic: hashing a Topic, a dataclass of enums, every step cost more than the copies)."""
-
-    @classmethod
-    def capture(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> StepState:
-        """Copy the state of the step just taken (cheap: small arrays and references to the fresh scans)."""
-        return cls(sim.sim_time_us, [_owned(topic.values(sim, names)) for topic in stepped])
 
 
 def _time(sim_time_us: int) -> object:
@@ -210,66 +185,34 @@ def template(topic: Topic, endpoint: Endpoint, sim: Simulation, names: Sequence[
     return bytes(TYPESTORE.serialize_cdr(msg, topic.msgtype))
 
 
-@dataclass
-class _Channel:
-    """One interface topic in the bag and, per recorded endpoint, its bag topic, message maker and endpoint:
-    a :class:`Layout` for the per-step topics, the built rosbags message for the latched ones."""
-
-    topic: Topic
-    outlets: list[tuple[str, Any, Endpoint]]
-    prepare: Callable[[Any], Any] | None = None
-    """The per-step topics' :meth:`Layout.prepare`."""
-
-
 class MessageBuilder:
-    """Turns a simulation's states into (topic, log time ns, CDR bytes) as stageros would publish them,
-    for the ``recorded`` topics only."""
+    """Turns a simulation into (topic, log time ns, CDR bytes) as stageros would publish them, for the
+    ``recorded`` topics only: the latched messages here (:meth:`static`), the per-step ones by
+    :attr:`stepping`, which the bag writer process runs."""
 
     def __init__(self, sim: Simulation, names: Sequence[RobotNames], recorded: list[RecordedTopic]) -> None:
         self._names = names
-        self._channels: list[_Channel] = []
+        self._latched: list[tuple[Topic, list[tuple[str, Any, Endpoint]]]] = []
+        channels = []
         for topic in topics.PUBLISHED:
             endpoints = [(r.name, r.endpoint) for r in recorded if r.endpoint.topic is topic]
             if not endpoints:
                 continue
             if topic.timing is Timing.START:
-                outlets = [(name, TOPIC_MESSAGES[topic].build(e, sim, names), e) for name, e in endpoints]
-                self._channels.append(_Channel(topic, outlets))
+                self._latched.append((topic, [(name, TOPIC_MESSAGES[topic].build(e, sim, names), e)
+                                              for name, e in endpoints]))
             else:
                 outlets = [(name, LAYOUTS[topic](template(topic, e, sim, names)), e) for name, e in endpoints]
-                self._channels.append(_Channel(topic, outlets, LAYOUTS[topic].prepare))
-        self._stepped = [c for c in self._channels if c.topic.timing is not Timing.START]
-        self.stepped = [c.topic for c in self._stepped]
-        """The recorded topics published every step: what :meth:`StepState.capture` takes, in this order."""
+                channels.append(StepChannel(topic, outlets, LAYOUTS[topic].prepare))
+        self.stepping = StepMessages(channels)
+        """The per-step messages: which topics a :class:`~stage_sim.bags.step_state.StepBatch` copies and how
+        the writer refills them."""
 
     def static(self, sim: Simulation) -> Iterator[tuple[str, int, bytes]]:
         """The latched messages stageros sends once at start: /tf_static, and /map when recorded."""
         time = _time(sim.sim_time_us)
         log_time = fields.stamp_ns(sim.sim_time_us)
-        for channel in self._channels:
-            if channel.topic.timing is Timing.START:
-                fill, values = TOPIC_MESSAGES[channel.topic].fill, channel.topic.values(sim, self._names)
-                for name, msg, endpoint in channel.outlets:
-                    data = TYPESTORE.serialize_cdr(fill(msg, values, endpoint, time), channel.topic.msgtype)
-                    yield name, log_time, bytes(data)
-
-    def step(self, state: StepState) -> Iterator[tuple[str, int, bytes]]:
-        """Everything one step publishes on the recorded topics, in stageros' publishing order."""
-        sim_time_us = state.sim_time_us
-        log_time = fields.stamp_ns(sim_time_us)
-        for channel, values in zip(self._stepped, state.values, strict=True):
-            values = channel.prepare(values)
-            for name, layout, endpoint in channel.outlets:
-                data = layout.refill(values, endpoint, sim_time_us)
-                if data is not None:
-                    yield name, log_time, data
-
-    def publications(self, state: StepState) -> int:
-        """How many messages :meth:`step` makes of ``state`` (without building them)."""
-        count = 0
-        for channel, values in zip(self._stepped, state.values, strict=True):
-            if channel.topic.timing is Timing.STEP:
-                count += len(channel.outlets)
-            else:
-                count += sum(values.measured(e.robot, e.ranger) is not None for _, _, e in channel.outlets)
-        return count
+        for topic, outlets in self._latched:
+            fill, values = TOPIC_MESSAGES[topic].fill, topic.values(sim, self._names)
+            for name, msg, endpoint in outlets:
+                yield name, log_time, bytes(TYPESTORE.serialize_cdr(fill(msg, values, endpoint, time), topic.msgtype))

@@ -1,13 +1,14 @@
 """Record a running simulation into an MCAP bag without holding up its steps.
 
-After every step the stepping thread copies what the step published (:class:`StepState`) into a bounded
-queue and goes on; a writer thread builds, serialises and writes the messages. When the queue is full (the
-writer, which shares the CPU with the simulation, or the disk cannot keep up):
+After every step the stepping thread copies what the step published into a :class:`StepBatch` and goes on; a
+batch of steps at a time goes into a bounded queue, from which a sender thread pipes it to the bag's writer
+process (:mod:`stage_sim.bags.writer`), which makes and writes the messages on another core. When the queue
+is full (the writer or the disk cannot keep up):
 
 * a lossless recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
   for the writer: the simulation slows down and every step is recorded;
-* a real-time recording drops the step rather than fall behind the wall clock: it is counted, the count is
-  said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
+* a real-time recording drops the batch rather than fall behind the wall clock: its steps are counted, the
+  count is said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
 
 A write error (full disk, file size limit) stops the recording with one message on stderr; the simulation
 goes on and the file stays readable up to its last chunk.
@@ -15,25 +16,37 @@ goes on and the file stays readable up to its last chunk.
 
 from __future__ import annotations
 
+import contextlib
+import os
 import queue
+import subprocess
 import sys
 import threading
+import time
 from dataclasses import dataclass
+from multiprocessing.connection import Connection
 from pathlib import Path
+from select import select as ready
 
-from stage_sim.bags.container import McapBag
 from stage_sim.bags.errors import BagError
-from stage_sim.bags.messages import TYPESTORE, MessageBuilder, StepState
+from stage_sim.bags.messages import MessageBuilder
+from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import select, stageros_topics
+from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan
 from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
+BATCH_BYTES = 1024 * 1024
+"""Bytes of steps sent to the writer at once (at most 64 steps): one pickling and one wake-up of the writer per
+batch instead of per step."""
 BATCH_STEPS = 64
-"""The writer thread is woken once per this many queued steps (at most half the queue; or every WAKE_S): each
-wake-up costs the stepping thread a hand-over of the GIL, so waking per step would cost more than the writing."""
 WAKE_S = 0.1
+"""Wall seconds a step waits at most before its batch is sent, however small: a slow (real-time) recording
+reaches the writer, and the disk, within this."""
 QUEUE_BYTES = 64 * 1024 * 1024
-"""Memory the queue of pending steps may hold (ranges and intensities dominate: 8 bytes per beam)."""
+"""Memory the queue of batches not yet sent may hold (ranges and intensities dominate: 8 bytes per beam)."""
+START_TIMEOUT_S = 120.0
+"""How long the writer process may take to start and create the file (a cold start imports for seconds)."""
 
 
 @dataclass(frozen=True)
@@ -70,114 +83,180 @@ class BagRecorder:
         self, sim: Simulation, path: str | Path, names: list[RobotNames], *, namespace: str = "/",
         topics: list[str] | None = None, with_map: bool = False, prog: str = "stage_sim", speedup: float = 0.0,
     ) -> None:
-        """Open the bag and write the latched messages (/tf_static, and /map when ``with_map``).
+        """Start the writer process, which creates the bag and writes the latched messages (/tf_static, and /map
+        when ``with_map``) before this returns.
 
         ``speedup``: the run's; ``<= 0`` (not paced) makes the recording lossless: :meth:`record_step` waits for
-        room in the queue instead of dropping the step.
+        room in the queue instead of dropping steps.
         ``topics`` restricts the recording to those names (relative ones resolved in ``namespace``).
         Raises ValueError for an unknown topic and BagError when the file cannot be written."""
         self._sim = sim
         self._prog = prog
+        self.path = Path(path)
         self.lossless = speedup <= 0
         self._names = names
         self.topics = select(stageros_topics(names, with_map, namespace), topics, namespace)
-        self._builder = MessageBuilder(sim, names, self.topics)
-        self._bag = McapBag(Path(path), self.topics, TYPESTORE, speedup)
-        self.messages = self.dropped_steps = self.dropped_messages = 0
+        builder = MessageBuilder(sim, names, self.topics)
+        self._messages = builder.stepping
+        plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping)
+        self._process, self._steps, self._reports = _start_writer()
+        opened = None
+        with contextlib.suppress(OSError):  # a writer that could not start: said below
+            self._steps.send(plan)
+            opened = self._next_report(START_TIMEOUT_S)
+        if not isinstance(opened, Opened) or opened.error:
+            self._steps.close()
+            self._reports.close()
+            raise BagError(opened.error if isinstance(opened, Opened) else
+                           f"cannot write bag {self.path}: {self._writer_end()}")
+        self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
         self.summary: BagSummary | None = None
         """What was recorded, once :meth:`close` has run."""
-        self._crash: BaseException | None = None
-        try:
-            for topic, log_time, data in self._builder.static(sim):
-                self._bag.write(topic, log_time, data)
-                self.messages += 1
-            self._bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
-        except OSError as exc:
-            self._bag.abort()
-            raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
-        beams = sum(r.sensor.samples for robot in sim.robots for r in robot.rangers)
-        self._queue: queue.Queue[StepState | None] = queue.Queue(
-            maxsize=max(16, min(10_000, QUEUE_BYTES // (8 * beams + 64 * len(sim.robots) + 64))))
-        self._batch = min(BATCH_STEPS, self._queue.maxsize // 2)
-        self._wake = threading.Event()
-        self._thread = threading.Thread(target=self._drain, name="bag-writer", daemon=True)
+        self._writer_lost = False
+        """Whether the writer process went away (the sender could not pipe to it)."""
+        self._closed: Closed | None = None
+        """The writer's last report, once it has ended (early only after a bug)."""
+        step_bytes = 8 * sum(r.sensor.samples for robot in sim.robots for r in robot.rangers) + 200 * len(sim.robots)
+        self._batch_steps = max(1, min(BATCH_STEPS, BATCH_BYTES // step_bytes))
+        self._queue: queue.Queue[StepBatch | None] = queue.Queue(
+            maxsize=max(2, QUEUE_BYTES // (self._batch_steps * step_bytes)))
+        self._pending = StepBatch.first(sim, names, self._messages.stepped, self._batch_steps)
+        self._pending_since = 0.0
+        self._thread = threading.Thread(target=self._send, name="bag-sender", daemon=True)
         self._thread.start()
+
+    @property
+    def writer_pid(self) -> int:
+        """The writer process's id (for a user, or a test, who wants to watch or pause it)."""
+        return self._process.pid
 
     @property
     def failed(self) -> bool:
         """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded)."""
-        return self.error is not None
+        self._read_reports()
+        return self.error is not None or self._writer_lost or self._closed is not None
 
     def record_step(self) -> None:
-        """Queue what the step just taken published: a full queue makes a lossless recording wait for the
-        writer and a real-time one drop the step."""
+        """Keep what the step just taken published; every batch's worth (or WAKE_S), queue it for the writer:
+        a full queue makes a lossless recording wait and a real-time one drop the batch."""
+        if self.error is not None:
+            return
+        if not self._pending.count:
+            self._pending_since = time.monotonic()
+        self._pending.capture(self._sim, self._names, self._messages.stepped)
+        if self._pending.full or time.monotonic() - self._pending_since >= WAKE_S:
+            self._hand_over(wait=self.lossless)
+
+    def _hand_over(self, wait: bool) -> None:
+        """Queue the pending steps; when the queue is full, wait for room if ``wait``, else drop them."""
+        batch, self._pending = self._pending, self._pending.empty(self._batch_steps)
         if self.failed:
             return
-        state = StepState.capture(self._sim, self._names, self._builder.stepped)
         try:
-            self._queue.put_nowait(state)
+            self._queue.put_nowait(batch)
         except queue.Full:
-            if not (self.lossless and self._wait_for_room(state)):
-                self.dropped_steps += 1
-                self.dropped_messages += self._builder.publications(state)
-                return
-        if self._queue.qsize() >= self._batch:
-            self._wake.set()
+            if not (wait and self._wait_for_room(batch)):
+                self.dropped_steps += batch.count
+                self.dropped_messages += sum(self._messages.publications(state) for state in batch.steps())
 
-    def _wait_for_room(self, state: StepState) -> bool:
-        """Queue ``state`` once the writer has made room; False if the writer stopped meanwhile (an error)."""
-        self._wake.set()
-        while self._thread.is_alive() and not self.failed and self._crash is None:
+    def _wait_for_room(self, batch: StepBatch) -> bool:
+        """Queue ``batch`` once the writer has made room; False if the recording stopped meanwhile."""
+        while self._thread.is_alive() and not self.failed:
             try:
-                self._queue.put(state, timeout=WAKE_S)
+                self._queue.put(batch, timeout=WAKE_S)
                 return True
             except queue.Full:
-                self._wake.set()
+                pass
         return False
 
     def close(self) -> BagSummary:
-        """Write what is queued, then the index: the file is complete. Safe to call once, also after errors."""
+        """Send what is pending, let the writer write the summary and wait for it: the file is complete. Safe
+        to call once, also after errors; re-raises (as RuntimeError) a bug that crashed the writer."""
+        if self._pending.count:
+            self._hand_over(wait=True)  # nothing is paced any more: the last steps are never dropped
         self._queue.put(None)
-        self._wake.set()
         self._thread.join()
-        if self._crash is not None:
-            self._bag.abort()
-            raise self._crash
-        if self.error is None:
+        if not self._writer_lost:
             try:
-                self._bag.finish({"dropped_steps": str(self.dropped_steps),
-                                  "dropped_messages": str(self.dropped_messages)})
-            except OSError as exc:
-                self.error = exc.strerror or str(exc)
-        self.summary = BagSummary(self._bag.path, self.messages, self.dropped_steps, self.dropped_messages, self.error)
+                self._steps.send(Finish({"dropped_steps": str(self.dropped_steps),
+                                         "dropped_messages": str(self.dropped_messages)}))
+            except OSError:
+                self._writer_lost = True
+        self._steps.close()
+        while self._closed is None and (report := self._next_report(None)) is not None:
+            self._take(report)
+        self._reports.close()
+        self._process.wait()
+        messages = 0
+        if self._closed is not None:
+            messages = self._closed.messages
+            if self._closed.crash:
+                raise RuntimeError(f"the bag writer process failed:\n{self._closed.crash}")
+        elif self.error is None:
+            self.error = f"the bag writer process ended before the bag was complete ({self._writer_end()})"
+        self.summary = BagSummary(self.path, messages, self.dropped_steps, self.dropped_messages, self.error)
         return self.summary
 
-    def _drain(self) -> None:
-        """The writer thread: build and write queued steps, a batch per wake-up, until the closing None."""
-        while True:
-            self._wake.wait(WAKE_S)
-            self._wake.clear()
-            while True:
+    def _send(self) -> None:
+        """The sender thread: pipe each queued batch to the writer (pickling it here, off the stepping thread),
+        until the closing None; if the writer has gone, the batches are dropped (close says why)."""
+        while (batch := self._queue.get()) is not None:
+            if not self._writer_lost:
                 try:
-                    state = self._queue.get_nowait()
-                except queue.Empty:
-                    break
-                if state is None:
-                    return
-                self._write(state)
+                    self._steps.send(batch)
+                except OSError:
+                    self._writer_lost = True
 
-    def _write(self, state: StepState) -> None:
-        """One step's messages into the bag; a write error stops the recording, a bug is kept for close()."""
-        if self.error is None and self._crash is None:
+    def _next_report(self, timeout: float | None) -> Opened | Failed | Closed | None:
+        """The writer's next report, None if it ended (or ``timeout`` passed) without one."""
+        if self._reports.closed:
+            return None
+        if timeout is not None and not ready([self._reports], [], [], timeout)[0]:
+            return None
+        try:
+            return self._reports.recv()
+        except EOFError:
+            return None
+
+    def _read_reports(self) -> None:
+        """Take the reports that have come, without waiting (once per batch: hence select, not
+        Connection.poll, which builds a selector per call)."""
+        while not self._reports.closed and ready([self._reports], [], [], 0)[0]:
             try:
-                for topic, log_time, data in self._builder.step(state):
-                    self._bag.write(topic, log_time, data)
-                    self.messages += 1
-            except OSError as exc:
-                self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
-                self._bag.abort()
-                print(f"{self._prog}: cannot write bag {self._bag.path}: {self.error}; recording stopped (recover "
-                      f"what was written with: stage_sim recover {self._bag.path})", file=sys.stderr, flush=True)
-            except BaseException as exc:  # a bug: re-raised by close() on the caller's thread
-                self._crash = exc
+                self._take(self._reports.recv())
+            except EOFError:  # the writer has ended: close() says how
+                self._reports.close()
+
+    def _take(self, report: Opened | Failed | Closed) -> None:
+        """Note a report: a write error is said at once, the end is kept for close()."""
+        if isinstance(report, Closed):
+            self._closed = report
+        elif isinstance(report, Failed) and self.error is None:
+            self.error = report.error
+            print(f"{self._prog}: cannot write bag {self.path}: {self.error}; recording stopped (recover what was "
+                  f"written with: stage_sim recover {self.path})", file=sys.stderr, flush=True)
+
+    def _writer_end(self) -> str:
+        """How the writer process ended, for a message."""
+        try:
+            code = self._process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            return "the writer process does not answer"
+        return f"the writer process exited with status {code}"
+
+
+def _start_writer() -> tuple[subprocess.Popen, Connection, Connection]:
+    """Start the writer process (:mod:`stage_sim.bags.writer`) with a pipe for steps and one for its reports;
+    the writer holds the only reading end of the first, so a killed simulation ends its input."""
+    steps_in, steps_out = os.pipe()
+    reports_in, reports_out = os.pipe()
+    root = str(Path(__file__).resolve().parents[2])  # where this stage_sim is, however the caller found it
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
+    try:
+        process = subprocess.Popen([sys.executable, "-m", "stage_sim.bags", str(steps_in), str(reports_out)],
+                                   pass_fds=(steps_in, reports_out), stdin=subprocess.DEVNULL, env=env)
+    finally:
+        os.close(steps_in)
+        os.close(reports_out)
+    return process, Connection(steps_out, readable=False), Connection(reports_in, writable=False)

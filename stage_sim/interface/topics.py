@@ -61,6 +61,11 @@ class Topic:
     on_request: bool = False
     """Published only when asked for (/map: the ``publish_map`` parameter, ``--map``)."""
 
+    def __reduce__(self) -> tuple[Callable[[str, str], Topic], tuple[str, str]]:
+        """Pickled as a reference to the registry's entry (its values are functions): the bag writer process
+        receives endpoints this way."""
+        return registered, (self.name, self.msgtype)
+
     def names_on(self, robot: RobotNames) -> tuple[str, ...]:
         """The topic's names on one robot (one per ranger for a per-ranger topic)."""
         if self.scope is Scope.RANGER:
@@ -128,6 +133,11 @@ CMD_VEL_STAMPED = Topic("cmd_vel", "geometry_msgs/msg/TwistStamped", RELIABLE_10
 
 RESET_POSITIONS = "reset_positions"
 """The std_srvs/srv/Empty service that puts every robot back at its start pose."""
+
+
+def registered(name: str, msgtype: str) -> Topic:
+    """The registry's topic of that name and type."""
+    return next(t for t in (*PUBLISHED, CMD_VEL, CMD_VEL_STAMPED) if (t.name, t.msgtype) == (name, msgtype))
 
 
 def published(with_map: bool) -> list[Topic]:

@@ -3,9 +3,12 @@ endpoint of every per-step topic (clock, odom, ground truth, stall, scans, tf), 
 
 from __future__ import annotations
 
+import pickle
+
 import pytest
 
-from stage_sim.bags.messages import LAYOUTS, TOPIC_MESSAGES, TYPESTORE, StepState, _time, template
+from stage_sim.bags.messages import LAYOUTS, TOPIC_MESSAGES, TYPESTORE, _time, template
+from stage_sim.bags.step_state import StepBatch
 from stage_sim.interface import topics
 from stage_sim.interface.topics import Timing
 from stage_sim.sim.simulation import Simulation
@@ -25,15 +28,19 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic) -> None:
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=5)
     names = names_of(sim)
     endpoints = topics.endpoints(topic, names)
-    layouts = [LAYOUTS[topic](template(topic, e, sim, names)) for e in endpoints]
+    # as the writer process gets them: pickled (a layout travels as its template)
+    layouts = pickle.loads(pickle.dumps([LAYOUTS[topic](template(topic, e, sim, names)) for e in endpoints]))
     messages = [TOPIC_MESSAGES[topic].build(e, sim, names) for e in endpoints]
     for robot, command in enumerate(COMMANDS):
         sim.set_velocity(robot, *command)
     compared = 0
     for _ in range(12):
         sim.step()
-        (values,) = StepState.capture(sim, names, [topic]).values
-        prepared = LAYOUTS[topic].prepare(values)
+        batch = StepBatch.first(sim, names, [topic], 1)
+        batch.capture(sim, names, [topic])
+        ((captured,),) = [state.values for state in pickle.loads(pickle.dumps(batch)).steps()]
+        prepared = LAYOUTS[topic].prepare(captured)
+        values = topic.values(sim, names)
         for endpoint, layout, msg in zip(endpoints, layouts, messages, strict=True):
             filled = TOPIC_MESSAGES[topic].fill(msg, values, endpoint, _time(sim.sim_time_us))
             refilled = layout.refill(prepared, endpoint, sim.sim_time_us)

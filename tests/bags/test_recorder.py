@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import signal
+import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -178,76 +183,107 @@ def test_unknown_topic_and_unwritable_path_are_errors_before_any_step(tmp_path) 
         BagRecorder(sim, tmp_path / "x.bag", names_of(sim))
 
 
-def slow_recorder(sim: Simulation, path: Path, monkeypatch: pytest.MonkeyPatch, lossless: bool) -> BagRecorder:
-    """A recorder with the smallest queue (16 steps) on a disk that takes 2 ms per message (24 ms per step of
-    the two-robot world), far slower than the simulation."""
+@contextlib.contextmanager
+def writer_paused(pid: int, seconds: float) -> Iterator[None]:
+    """The writer process stopped (SIGSTOP, as a starved or swapped-out process is) for ``seconds``, or until
+    the block ends."""
+    def resume() -> None:
+        with contextlib.suppress(ProcessLookupError):  # it may have ended since
+            os.kill(pid, signal.SIGCONT)
+
+    os.kill(pid, signal.SIGSTOP)
+    timer = threading.Timer(seconds, resume)
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+        resume()
+
+
+def small_queue(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The smallest queue: two batches of one step (the pipe to the writer holds some 40 more)."""
     monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)
-    recorder = BagRecorder(sim, path, names_of(sim), speedup=0.0 if lossless else 1.0)
-    write = recorder._bag.write
-
-    def slow_write(*args) -> None:
-        time.sleep(0.002)
-        write(*args)
-
-    monkeypatch.setattr(recorder._bag, "write", slow_write)
-    return recorder
+    monkeypatch.setattr("stage_sim.bags.recorder.BATCH_STEPS", 1)
 
 
-def test_a_lossless_recording_waits_for_a_slow_writer_and_records_every_step(tmp_path, monkeypatch) -> None:
+def test_a_lossless_recording_waits_for_a_stalled_writer_and_records_every_step(tmp_path, monkeypatch) -> None:
+    small_queue(monkeypatch)
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
     path = tmp_path / "slow.mcap"
-    recorder = slow_recorder(sim, path, monkeypatch, lossless=True)
-    for _ in range(60):
-        sim.step()
-        recorder.record_step()
+    recorder = BagRecorder(sim, path, names_of(sim), speedup=0.0)
+    start = time.monotonic()
+    with writer_paused(recorder.writer_pid, 1.0):
+        for _ in range(300):
+            sim.step()
+            recorder.record_step()
+        waited = time.monotonic() - start
     summary = recorder.close()
-    assert (summary.dropped_steps, summary.messages, summary.complete) == (0, 1 + 60 * 12, True)
-    assert READERS["mcap"](path).counts()["/clock"] == 60
+    assert waited >= 0.9  # the simulation waited for the writer
+    assert (summary.dropped_steps, summary.messages, summary.complete) == (0, 1 + 300 * 12, True)
+    assert READERS["mcap"](path).counts()["/clock"] == 300
 
 
-def test_a_disk_too_slow_drops_steps_instead_of_stalling_and_the_bag_says_so(tmp_path, monkeypatch) -> None:
+def test_a_stalled_writer_at_real_time_drops_steps_instead_of_stalling_and_the_bag_says_so(
+        tmp_path, monkeypatch) -> None:
+    small_queue(monkeypatch)
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
     path = tmp_path / "slow.mcap"
-    recorder = slow_recorder(sim, path, monkeypatch, lossless=False)
+    recorder = BagRecorder(sim, path, names_of(sim), speedup=1.0)
     longest = 0.0
-    for _ in range(150):
-        sim.step()
-        start = time.perf_counter()
-        recorder.record_step()
-        longest = max(longest, time.perf_counter() - start)
+    with writer_paused(recorder.writer_pid, 60.0):
+        for _ in range(300):
+            sim.step()
+            start = time.perf_counter()
+            recorder.record_step()
+            longest = max(longest, time.perf_counter() - start)
     summary = recorder.close()
     assert summary.dropped_steps > 0 and longest < 0.05 and not summary.complete
-    assert summary.messages + summary.dropped_messages == 1 + 150 * 12
+    assert summary.messages + summary.dropped_messages == 1 + 300 * 12
     assert f"dropped {summary.dropped_messages} messages of {summary.dropped_steps} steps" in summary.describe()
     bag = READERS["mcap"](path)
-    assert bag.counts()["/clock"] == 150 - summary.dropped_steps
+    assert bag.counts()["/clock"] == 300 - summary.dropped_steps
     with path.open("rb") as stream:
         (record,) = [m for m in make_reader(stream).iter_metadata() if m.name == "stage_sim"]
     assert record.metadata == {"dropped_steps": str(summary.dropped_steps),
                                "dropped_messages": str(summary.dropped_messages)}
 
 
+def test_a_writer_that_dies_ends_the_recording_with_a_message_and_the_run_goes_on(tmp_path) -> None:
+    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
+    recorder = BagRecorder(sim, tmp_path / "run.mcap", names_of(sim), speedup=0.0)
+    os.kill(recorder.writer_pid, signal.SIGKILL)
+    deadline = time.monotonic() + 10
+    while not recorder.failed:
+        sim.step()
+        recorder.record_step()
+        assert time.monotonic() < deadline
+    summary = recorder.close()
+    assert not summary.complete and "the bag writer process ended before the bag was complete" in summary.error
+    assert "exited with status -9" in summary.error
+
+
 @pytest.mark.parametrize(("speedup", "status"), [("0", 0), ("20", 1)])
 def test_stage_sim_run_records_every_step_unless_paced_and_says_so_by_its_status(
         tmp_path, monkeypatch, capsys, speedup, status) -> None:
-    """Unpaced (``--speedup 0``) the run waits for a slow writer; paced to the wall clock it drops steps
+    """Unpaced (``--speedup 0``) the run waits for a stalled writer; paced to the wall clock it drops steps
     and exits 1, naming the cause."""
-    from stage_sim.bags.container import McapBag
     from stage_sim.cli import main
 
-    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)
-    write = McapBag.write
+    small_queue(monkeypatch)
+    start = BagRecorder.__init__
 
-    def slow_write(self, *args) -> None:
-        time.sleep(0.002)
-        write(self, *args)
+    def stalled_start(self, *args, **kwargs) -> None:  # the writer stalls for 3 s (longer than the run)
+        start(self, *args, **kwargs)
+        stack.enter_context(writer_paused(self.writer_pid, 3.0))
 
-    monkeypatch.setattr(McapBag, "write", slow_write)
+    monkeypatch.setattr(BagRecorder, "__init__", stalled_start)
     path = tmp_path / "run.mcap"
-    assert main(["run", str(two_robot_world(tmp_path)), "--duration", "4", "--speedup", speedup,
-                 "--bag", str(path)]) == status
+    with contextlib.ExitStack() as stack:
+        assert main(["run", str(two_robot_world(tmp_path)), "--duration", "40", "--speedup", speedup,
+                     "--bag", str(path)]) == status
     clocks = READERS["mcap"](path).counts()["/clock"]
     if status == 0:
-        assert clocks == 40
+        assert clocks == 400
     else:
-        assert clocks < 40 and "could not keep up" in capsys.readouterr().err
+        assert clocks < 400 and "could not keep up" in capsys.readouterr().err

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import struct
 from pathlib import Path
 
@@ -109,13 +110,15 @@ def test_an_unwritable_output_is_a_clear_error(tmp_path, complete_bag) -> None:
 
 def test_a_kill_9_at_real_time_loses_about_a_second(tmp_path) -> None:
     """Chunks close after a sim second: a slow recording (two robots at real time fill a 1 MiB chunk in
-    ~14 s) reaches the disk chunk after chunk within seconds, /tf_static first, and survives a kill -9."""
+    ~14 s) reaches the disk chunk after chunk within seconds, /tf_static first, and survives a kill -9 of the
+    simulator and its bag writer both."""
     bag_path = tmp_path / "killed.mcap"
-    process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "1", "--bag", bag_path)
+    process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "1", "--bag", bag_path,
+                    start_new_session=True)
     try:
         wait_for_chunks(bag_path, 3, process, timeout_s=15.0)  # the latched messages, then two chunks of steps
     finally:
-        process.kill()
+        os.killpg(process.pid, signal.SIGKILL)
         process.communicate()
     result = recover(bag_path, tmp_path / "out.mcap")
     bag = READERS["rosbags"](tmp_path / "out.mcap")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 from mcap.records import Chunk
 from mcap.stream_reader import StreamReader
 from rosbags.highlevel import AnyReaderError
@@ -137,11 +138,52 @@ def test_ctrl_c_finalises_the_bag(tmp_path) -> None:
         assert counts["/clock"] > 10 and counts["/robot_1/base_scan_1"] == counts["/clock"]
 
 
-def test_after_kill_9_the_bag_is_recovered_up_to_its_last_chunk(tmp_path) -> None:
+def writer_of(process: subprocess.Popen) -> int:
+    """The process id of a run's bag writer (its only child)."""
+    (pid,) = {int(child) for task in os.listdir(f"/proc/{process.pid}/task")
+              for child in Path(f"/proc/{process.pid}/task/{task}/children").read_text().split()}
+    return pid
+
+
+def wait_until_gone(pid: int, timeout_s: float = 30.0) -> None:
+    """Until process ``pid`` has ended (gone, or a zombie nobody reaps)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z":
+                return
+        except FileNotFoundError:
+            return
+        assert time.monotonic() < deadline, f"process {pid} did not end"
+        time.sleep(0.05)
+
+
+def test_after_kill_9_of_the_simulator_its_writer_completes_the_bag(tmp_path) -> None:
+    """The bag writer is a process of its own: the simulator killed, it writes every step it was sent and
+    the summary, and says in the bag's metadata that the run was cut."""
     bag_path = tmp_path / "killed.mcap"
     process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "0", "--bag", bag_path)
     wait_for_chunks(bag_path, 2, process)  # the latched messages, then a first 1 MiB chunk
+    writer = writer_of(process)
     process.kill()
+    process.communicate()
+    wait_until_gone(writer)
+    for reader in READERS.values():  # complete: both readers open it as it is
+        bag = reader(bag_path)
+        clocks = [t for t, _ in bag.messages["/clock"]]
+        assert len(clocks) > 100 and clocks == [100_000_000 * (i + 1) for i in range(len(clocks))]
+        assert all(len(items) == len(clocks) for topic, items in bag.messages.items() if topic != "/tf_static")
+    with bag_path.open("rb") as stream:
+        (record,) = [m for m in make_reader(stream).iter_metadata() if m.name == "stage_sim"]
+    assert record.metadata["interrupted"].startswith("the simulation ended without closing the bag after sim time")
+
+
+def test_after_kill_9_of_both_the_bag_is_recovered_up_to_its_last_chunk(tmp_path) -> None:
+    bag_path = tmp_path / "killed.mcap"
+    process = start("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "0", "--bag", bag_path,
+                    start_new_session=True)
+    wait_for_chunks(bag_path, 2, process)  # the latched messages, then a first 1 MiB chunk
+    os.killpg(process.pid, signal.SIGKILL)
     process.communicate()
     with pytest.raises(AnyReaderError, match="end magic is invalid"):  # no footer: rosbags refuses the file
         READERS["rosbags"](bag_path)

@@ -1,0 +1,217 @@
+"""What steps published, copied off the simulation: what the stepping side sends the bag writer process.
+
+The stepping side copies each step into a :class:`StepBatch`, column by column (one preallocated array per
+value of a per-step topic, a row per step), and sends the batch whole: a step costs it a few array copies, and
+pickling a batch a few arrays however many steps it holds (a step's values pickled one by one cost about as
+much as simulating a one-robot step). The writer reads the batch back step by step, as :class:`StepState`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from stage_sim.interface import fields
+from stage_sim.interface.names import RobotNames
+from stage_sim.interface.topics import Topic
+
+if TYPE_CHECKING:
+    from stage_sim.sim.simulation import Simulation
+
+
+@dataclass(frozen=True)
+class PackedScans:
+    """The scans one step measured, every ranger's beams end to end: ``measured(robot, ranger)`` answers as
+    :class:`fields.LatestScans` does, with (ranges, intensities) float32 views."""
+
+    first: tuple[int, ...]
+    """(robots + 1,) index of each robot's first ranger in ``offsets``."""
+    offsets: list[int]
+    """Where each ranger's beams start in the arrays; -1: it took no scan this step."""
+    lengths: tuple[int, ...]
+    ranges: np.ndarray
+    intensities: np.ndarray
+
+    def measured(self, robot: int, ranger: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """The ranges and intensities ranger ``ranger`` of robot ``robot`` took in this step, None if none."""
+        k = self.first[robot] + ranger
+        start = self.offsets[k]
+        if start < 0:
+            return None
+        end = start + self.lengths[k]
+        return self.ranges[start:end], self.intensities[start:end]
+
+
+@dataclass(frozen=True)
+class StepState:
+    """What one step published: its sim time and the values (:attr:`Topic.values`) of the recorded per-step
+    topics, in their order (a list, not a dict by topic: hashing a Topic, a dataclass of enums, per step cost
+    more than the rest)."""
+
+    sim_time_us: int
+    values: list[Any]
+
+
+class _Column(ABC):
+    """One value of a per-step topic, for the steps of a batch: a row per step."""
+
+    @abstractmethod
+    def empty(self, size: int) -> _Column:
+        """A column like this one with room for ``size`` steps."""
+
+    @abstractmethod
+    def put(self, k: int, value: Any) -> None:
+        """Copy step ``k``'s value."""
+
+    @abstractmethod
+    def row(self, k: int) -> Any:
+        """Step ``k``'s value, as the topic's layout reads it."""
+
+    @abstractmethod
+    def head(self, count: int) -> _Column:
+        """The first ``count`` rows (views): what is pickled of a batch that is not full."""
+
+
+class _Array(_Column):
+    """An array value (poses, velocities, stall flags) or a number (the sim time)."""
+
+    def __init__(self, data: np.ndarray) -> None:
+        self.data = data
+
+    @classmethod
+    def like(cls, value: Any) -> _Array:
+        """An empty column for values like ``value``."""
+        value = np.asarray(value)
+        return cls(np.empty((0, *value.shape), value.dtype))
+
+    def empty(self, size: int) -> _Array:
+        return _Array(np.empty((size, *self.data.shape[1:]), self.data.dtype))
+
+    def put(self, k: int, value: Any) -> None:
+        self.data[k] = value
+
+    def row(self, k: int) -> Any:
+        return self.data[k] if self.data.ndim > 1 else self.data[k].item()
+
+    def head(self, count: int) -> _Array:
+        return _Array(self.data[:count])
+
+
+class _Tuple(_Column):
+    """A tuple of values (odometry: poses and velocities)."""
+
+    def __init__(self, parts: list[_Column]) -> None:
+        self.parts = parts
+
+    def empty(self, size: int) -> _Tuple:
+        return _Tuple([part.empty(size) for part in self.parts])
+
+    def put(self, k: int, value: tuple) -> None:
+        for part, item in zip(self.parts, value, strict=True):
+            part.put(k, item)
+
+    def row(self, k: int) -> tuple:
+        return tuple(part.row(k) for part in self.parts)
+
+    def head(self, count: int) -> _Tuple:
+        return _Tuple([part.head(count) for part in self.parts])
+
+
+class _Scans(_Column):
+    """The scans a step measured (:class:`fields.LatestScans`), packed: the measured rangers' beams end to end in
+    one row, and which rangers measured."""
+
+    def __init__(self, first: tuple[int, ...], lengths: tuple[int, ...], size: int) -> None:
+        self.first, self.lengths = first, lengths
+        self.beams = sum(lengths)
+        self.ranges = np.empty((size, self.beams), np.float32)
+        self.intensities = np.empty((size, self.beams), np.float32)
+        self.measured = np.zeros((size, len(lengths)), bool)
+
+    def empty(self, size: int) -> _Scans:
+        return _Scans(self.first, self.lengths, size)
+
+    def put(self, k: int, value: fields.LatestScans) -> None:
+        scans = [scan for robot in value.scans for scan in robot]
+        measured = [scan.stamp == value.time for scan in scans]
+        if all(measured):  # the common case: every ranger measures every step
+            self.measured[k] = True
+            taken, beams = scans, self.beams
+        else:
+            self.measured[k] = measured
+            taken = [scan for scan, took in zip(scans, measured, strict=True) if took]
+            beams = sum(len(scan.ranges) for scan in taken)
+        if len(taken) == 1:
+            self.ranges[k, :beams], self.intensities[k, :beams] = taken[0].ranges, taken[0].intensities
+        elif taken:
+            np.concatenate([scan.ranges for scan in taken], out=self.ranges[k, :beams])
+            np.concatenate([scan.intensities for scan in taken], out=self.intensities[k, :beams])
+
+    def row(self, k: int) -> PackedScans:
+        offsets, at = [], 0
+        for measured, length in zip(self.measured[k].tolist(), self.lengths, strict=True):
+            offsets.append(at if measured else -1)
+            at += length if measured else 0
+        return PackedScans(self.first, offsets, self.lengths, self.ranges[k], self.intensities[k])
+
+    def head(self, count: int) -> _Scans:
+        head = _Scans(self.first, self.lengths, 0)
+        head.ranges, head.intensities, head.measured = (
+            self.ranges[:count], self.intensities[:count], self.measured[:count])
+        return head
+
+
+def _column(value: Any, sim: Simulation) -> _Column:
+    """The column for a topic's values, shaped after one step's ``value``."""
+    if isinstance(value, tuple):
+        return _Tuple([_column(item, sim) for item in value])
+    if isinstance(value, fields.LatestScans):
+        counts = [len(robot.rangers) for robot in sim.robots]
+        first = tuple(int(i) for i in np.concatenate([[0], np.cumsum(counts)]))
+        return _Scans(first, tuple(r.sensor.samples for robot in sim.robots for r in robot.rangers), 0)
+    return _Array.like(value)
+
+
+class StepBatch:
+    """Up to ``size`` consecutive steps' values, a column per value; :meth:`capture` adds one."""
+
+    def __init__(self, times: _Array, columns: list[_Column], size: int) -> None:
+        self._times = times.empty(size)
+        self._columns = [column.empty(size) for column in columns]
+        self.count = 0
+
+    @classmethod
+    def first(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic], size: int) -> StepBatch:
+        """An empty batch for the values of the ``stepped`` topics, shaped after the simulation's."""
+        columns = [_column(topic.values(sim, names), sim) for topic in stepped]
+        return cls(_Array.like(sim.sim_time_us), columns, size)
+
+    def empty(self, size: int) -> StepBatch:
+        """An empty batch like this one (the stepping side starts one as it hands the last over)."""
+        return StepBatch(self._times, self._columns, size)
+
+    @property
+    def full(self) -> bool:
+        return self.count == len(self._times.data)
+
+    def capture(self, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> None:
+        """Copy the step just taken."""
+        k = self.count
+        self._times.put(k, sim.sim_time_us)
+        for column, topic in zip(self._columns, stepped, strict=True):
+            column.put(k, topic.values(sim, names))
+        self.count += 1
+
+    def steps(self) -> Iterator[StepState]:
+        """The steps held, in order."""
+        for k in range(self.count):
+            yield StepState(self._times.row(k), [column.row(k) for column in self._columns])
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Only the rows filled travel to the writer."""
+        return {"count": self.count, "_times": self._times.head(self.count),
+                "_columns": [column.head(self.count) for column in self._columns]}

@@ -1,0 +1,162 @@
+"""The bag's writer process: turns the steps a simulation sends it into messages in the MCAP file.
+
+Why a process and not a thread: refilling and writing a 100-robot step (400 messages) costs about as much CPU
+as simulating it, and a thread shares the simulation's GIL (recording then cost half the simulation rate). In a
+process of its own it runs on another core, and the stepping side only copies each step
+(:class:`~stage_sim.bags.step_state.StepBatch`) and sends batches of steps through a pipe.
+
+The process is ``python -m stage_sim.bags STEPS REPORTS`` (:mod:`stage_sim.bags.__main__`): a fresh
+interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would re-run
+the user's main script. STEPS and REPORTS are its two pipes' file descriptors; what goes through them is
+pickled by :mod:`multiprocessing.connection`. It first reads a :class:`WriterPlan` from the steps pipe and
+answers on the reports pipe with :class:`Opened` once the file is created and the latched messages are on
+disk, :class:`Failed` when the disk refuses a write (it then reads and discards what comes, so the simulation
+is never blocked by a dead recording), and :class:`Closed` at the end. It reads lists of steps until
+:class:`Finish`, or until the pipe ends without one (the simulation was killed): it then still writes the
+summary, so a kill -9 of the simulator leaves a complete bag of every step it had sent. It ignores SIGINT and
+SIGTERM: Ctrl-C in a terminal reaches the whole process group, and the simulation's own handler closes the
+recording in order.
+"""
+
+from __future__ import annotations
+
+import signal
+import traceback
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection
+from pathlib import Path
+
+from stage_sim.bags.container import McapBag
+from stage_sim.bags.errors import BagError
+from stage_sim.bags.step_messages import StepMessages
+from stage_sim.bags.step_state import StepBatch
+from stage_sim.bags.topics import Topic
+
+
+@dataclass(frozen=True)
+class WriterPlan:
+    """Everything the writer process needs, made by the stepping side from its simulation."""
+
+    path: Path
+    topics: list[Topic]
+    speedup: float
+    """The run's (``<= 0``: not paced; chunks then close by size only, see :mod:`stage_sim.bags.container`)."""
+    static: list[tuple[str, int, bytes]]
+    """The latched messages, serialised (/tf_static, /map)."""
+    messages: StepMessages
+
+
+@dataclass(frozen=True)
+class Finish:
+    """The last thing sent: the run is over; ``metadata`` goes into the bag's ``stage_sim`` record."""
+
+    metadata: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Opened:
+    """The answer to the start: the file is there with the latched messages, or ``error`` says why not."""
+
+    error: str | None
+
+
+@dataclass(frozen=True)
+class Failed:
+    """A write was refused: the recording stopped at this point, the file is readable up to its last chunk."""
+
+    error: str
+
+
+@dataclass(frozen=True)
+class Closed:
+    """The end: how many messages are in the bag; ``crash``: the traceback of a bug in the writer."""
+
+    messages: int
+    crash: str | None = None
+
+
+class _Writer:
+    """The bag and its counts; a write error ends the writing, not the reading."""
+
+    def __init__(self, bag: McapBag, messages: StepMessages, reports: Connection) -> None:
+        self.bag = bag
+        self._messages = messages
+        self._reports = reports
+        self.count = 0
+        self.last_us: int | None = None
+        """The sim time of the last step written."""
+        self.error: str | None = None
+
+    def write(self, topic: str, log_time: int, data: bytes) -> None:
+        self.bag.write(topic, log_time, data)
+        self.count += 1
+
+    def steps(self, batch: StepBatch) -> None:
+        """Write the batch's steps, unless an earlier write failed (then they are dropped: the recording has
+        stopped)."""
+        for state in batch.steps():
+            self.last_us = state.sim_time_us
+            if self.error is not None:
+                return
+            try:
+                for message in self._messages.step(state):
+                    self.write(*message)
+            except OSError as exc:
+                self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
+                self.bag.abort()
+                self._reports.send(Failed(self.error))
+
+
+def main(argv: list[str]) -> None:
+    """The process: ``STEPS REPORTS`` are the file descriptors of its two pipes."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    steps, reports = Connection(int(argv[0]), writable=False), Connection(int(argv[1]), readable=False)
+    try:
+        plan = steps.recv()
+    except EOFError:  # the simulation ended before it sent the plan
+        return
+    write_bag(plan, steps, reports)
+
+
+def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
+    """Open the bag, write the latched messages, then every step sent, then the summary."""
+    try:
+        bag = McapBag(plan.path, plan.topics, plan.speedup)
+    except BagError as exc:
+        reports.send(Opened(str(exc)))
+        return
+    writer = _Writer(bag, plan.messages, reports)
+    try:
+        try:
+            for message in plan.static:
+                writer.write(*message)
+            bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
+        except OSError as exc:
+            bag.abort()
+            reports.send(Opened(f"cannot write bag {plan.path}: {exc.strerror or exc}"))
+            return
+        reports.send(Opened(None))
+        metadata = _write_steps(writer, steps)
+        if writer.error is None:
+            try:
+                bag.finish(metadata)
+            except OSError as exc:
+                reports.send(Failed(exc.strerror or str(exc)))
+        reports.send(Closed(writer.count))
+    except BaseException:  # a bug: the stepping side raises it with this traceback
+        bag.abort()
+        reports.send(Closed(writer.count, traceback.format_exc()))
+
+
+def _write_steps(writer: _Writer, steps: Connection) -> dict[str, str]:
+    """Write what comes until :class:`Finish` (its metadata) or the end of the pipe (the sender was killed)."""
+    while True:
+        try:
+            item = steps.recv()
+        except EOFError:
+            stopped = "its start" if writer.last_us is None else f"sim time {writer.last_us / 1e6:g} s"
+            return {"interrupted": f"the simulation ended without closing the bag after {stopped}"}
+        if isinstance(item, Finish):
+            return item.metadata
+        writer.steps(item)

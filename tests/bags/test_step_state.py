@@ -1,0 +1,65 @@
+"""A batch of steps, pickled as it travels to the bag writer, gives back every step's values as the
+simulation had them: poses, times and which rangers measured what (rangers at different rates, a robot
+without any)."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+
+from stage_sim.bags.step_state import StepBatch
+from stage_sim.interface import topics
+from stage_sim.interface.names import robot_names
+from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.loader import load_world_text
+from tests.bags.worlds import REPO
+
+WORLD = f"""
+resolution 0.02
+interval_sim 100
+define floorplan model ( color "SlateGray" boundary 1 obstacle_return 1 )
+floorplan( size [27.05 21.65 1.0] pose [13.525 10.825 0 0] bitmap "{REPO / 'maps/rooms.png'}" )
+define fast ranger ( sensor( range [0.0 5.6] fov 240.0 samples 50 ) size [0.06 0.06 0.06] )
+define slow ranger ( sensor( range [0.1 3.0] fov 90.0 samples 7 ) update_interval 300 size [0.06 0.06 0.06] )
+define bot position ( size [0.4 0.3 0.2] drive "diff" odom_error [0.03 0.03 0 0.05] )
+bot( pose [11.1 9.2 0 90] fast( pose [0.2 0 -0.1 0] ) slow( pose [-0.2 0 -0.1 180] ) )
+bot( pose [4.0 4.0 0 0] )
+bot( pose [6.0 4.0 0 0] slow( pose [0.2 0 -0.1 0] ) )
+"""
+
+STEPPED = [t for t in topics.PUBLISHED if t.timing is not topics.Timing.START]
+
+
+def test_a_pickled_batch_gives_back_every_step(tmp_path) -> None:
+    sim = Simulation(load_world_text(WORLD, str(tmp_path / "w.world")), seed=2)
+    names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers)) for r in sim.robots]
+    for robot in range(3):
+        sim.set_velocity(robot, 0.3, 0.0, 0.2 * robot)
+    batch = StepBatch.first(sim, names, STEPPED, 10)
+    expected = []
+    for _ in range(7):  # not full: only the rows filled travel
+        sim.step()
+        batch.capture(sim, names, STEPPED)
+        scans = {(r, k): (s.ranges.copy(), s.intensities.copy()) if s.stamp == sim.sim_time else None
+                 for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
+        expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
+    assert not batch.full
+    steps = list(pickle.loads(pickle.dumps(batch)).steps())
+    assert len(steps) == 7
+    skipped = 0
+    for state, (time_us, odometry, velocities, scans) in zip(steps, expected, strict=True):
+        values = dict(zip(STEPPED, state.values, strict=True))
+        assert state.sim_time_us == time_us and values[topics.CLOCK] == time_us
+        np.testing.assert_array_equal(values[topics.ODOM][0], odometry)
+        np.testing.assert_array_equal(values[topics.GROUND_TRUTH][1], velocities)
+        np.testing.assert_array_equal(values[topics.TF], odometry)
+        for (robot, ranger), scan in scans.items():
+            packed = values[topics.SCAN].measured(robot, ranger)
+            if scan is None:
+                assert packed is None
+                skipped += 1
+            else:
+                np.testing.assert_array_equal(packed[0], scan[0])
+                np.testing.assert_array_equal(packed[1], scan[1])
+    assert skipped > 0  # the slow rangers skipped steps
