@@ -99,16 +99,23 @@ class BagRecorder:
         builder = MessageBuilder(sim, names, self.topics)
         self._messages = builder.stepping
         plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping)
-        self._process, self._steps, self._reports = _start_writer()
+        try:
+            self._process, self._steps, self._reports = _start_writer()
+        except OSError as exc:  # no processes left, or the interpreter is gone
+            raise BagError(f"cannot start the bag writer process: {exc.strerror or exc}") from None
         opened = None
         with contextlib.suppress(OSError):  # a writer that could not start: said below
             self._steps.send(plan)
             opened = self._next_report(START_TIMEOUT_S)
         if not isinstance(opened, Opened) or opened.error:
-            self._steps.close()
+            self._steps.close()  # a writer still starting reads the end of its input and exits
             self._reports.close()
-            raise BagError(opened.error if isinstance(opened, Opened) else
-                           f"cannot write bag {self.path}: {self._writer_end()}")
+            reason = (opened.error if isinstance(opened, Opened)
+                      else f"cannot write bag {self.path}: {self._writer_end()}")
+            if self._process.poll() is None:
+                self._process.kill()
+                self._process.wait()
+            raise BagError(reason)
         self.dropped_steps = self.dropped_messages = 0
         self.error: str | None = None
         self.summary: BagSummary | None = None
