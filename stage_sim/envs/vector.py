@@ -8,7 +8,10 @@ once for all worlds as arrays instead of once per world; only the simulation ste
 
 Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
 next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
-neither terminated nor truncated.
+neither terminated nor truncated. ``autoreset_mode=AutoresetMode.SAME_STEP`` (or ``"SameStep"``; what Stable-Baselines3 and other libraries
+that predate Gymnasium 1.0 expect) resets it within the step that ended it instead: that step returns the new
+episode's first observation, and the last one in ``infos["final_obs"]`` (with its infos in
+``infos["final_info"]``), as ``SyncVectorEnv(..., autoreset_mode=AutoresetMode.SAME_STEP)`` does.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from typing import Any
 import gymnasium
 import numpy as np
 from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
@@ -32,10 +36,15 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
 
     def __init__(
         self, num_envs: int, world: str | None = None, robot: int = 0, history: int = 3, max_steps: int = 500,
-        discrete: bool = False, reward: RewardConfig | None = None, **scenario: Any,
+        discrete: bool = False, reward: RewardConfig | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP, **scenario: Any,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be at least 1, got {num_envs}")
+        self.autoreset_mode = AutoresetMode(autoreset_mode)
+        if self.autoreset_mode not in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+            raise ValueError(f"autoreset_mode must be NextStep or SameStep, got {self.autoreset_mode.value}")
+        self.metadata = {**self.metadata, "autoreset_mode": self.autoreset_mode}
         options = ScenarioOptions(world=world, **scenario)
         if options.scenario == "circle":
             raise ValueError("circle crossing needs several robots: use stage_sim.envs.NavigateParallelEnv")
@@ -80,7 +89,10 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         return rows, {"goal": self.goals.copy(), "_goal": np.ones(self.num_envs, dtype=bool)}
 
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        """One step of every world; worlds whose episode ended at the last step are reset instead."""
+        """One step of every world; next-step autoreset: worlds whose episode ended at the last step are reset
+        instead; same-step: worlds whose episode ends in this one are reset after it."""
+        if self.autoreset_mode is AutoresetMode.SAME_STEP:
+            return self._step_and_reset(actions)
         restart = self._autoreset.copy()
         moving = ~restart
         result = self.advance(actions, moving)
@@ -93,6 +105,37 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         infos.update({f"_{key}": moving.copy() for key in list(infos)})
         if restart.any():
             infos["goal"], infos["_goal"] = self.goals.copy(), restart
+        return observations, result.rewards, result.terminated, result.truncated, infos
+
+    def _step_and_reset(
+        self, actions: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Same-step autoreset, with the infos ``SyncVectorEnv`` gathers: an ended world's step infos under
+        ``final_info`` and its last observation in ``final_obs``, its reset infos (goal, distance) at the top."""
+        everyone = np.ones(self.num_envs, dtype=bool)
+        result = self.advance(actions, everyone)
+        observations = result.observations
+        ended = result.terminated | result.truncated
+        going = ~ended
+        stepped = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
+                   "time": self.steps * self._interval}
+        infos: dict[str, Any] = {}
+        if going.any():  # a key only when some world has it, as SyncVectorEnv gathers them
+            for key, values in stepped.items():
+                infos[key], infos[f"_{key}"] = np.where(going, values, np.zeros_like(values)), going.copy()
+        if ended.any():
+            final_obs = np.full(self.num_envs, None, dtype=object)
+            final_info: dict[str, Any] = {}
+            for key, values in stepped.items():
+                final_info[key], final_info[f"_{key}"] = np.where(ended, values, np.zeros_like(values)), ended.copy()
+            for world in np.flatnonzero(ended):
+                final_obs[world] = observations[world].copy()
+                observations[world] = self._reset_world(world, None)
+            infos["final_obs"], infos["_final_obs"] = final_obs, ended.copy()
+            infos["final_info"], infos["_final_info"] = final_info, ended.copy()
+            infos["goal"], infos["_goal"] = np.where(ended[:, None], self.goals, 0.0), ended.copy()
+            infos["distance"] = np.where(ended, self.distance, infos.get("distance", 0.0))
+            infos["_distance"] = everyone
         return observations, result.rewards, result.terminated, result.truncated, infos
 
     def advance(self, actions: np.ndarray, moving: np.ndarray) -> StepResult:

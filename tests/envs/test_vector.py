@@ -76,3 +76,46 @@ def test_batches_have_the_dtypes_gymnasium_vector_envs_use_and_lie_in_the_spaces
     assert observations in envs.observation_space
     assert (rewards.dtype, terminated.dtype, truncated.dtype) == (np.float64, np.bool_, np.bool_)
     assert rewards.shape == terminated.shape == truncated.shape == (2,)
+
+
+def assert_same_infos(mine: dict, theirs: dict) -> None:
+    """The same keys, masks and (where masked in) values, recursively."""
+    assert set(mine) == set(theirs)
+    for key, value in theirs.items():
+        if isinstance(value, dict):
+            assert_same_infos(mine[key], value)
+        elif key.startswith("_"):
+            assert np.array_equal(mine[key], value), key
+        elif key == "final_obs":
+            for world in np.flatnonzero(theirs["_final_obs"]):
+                assert np.array_equal(mine[key][world], value[world])
+        else:
+            mask = theirs[f"_{key}"]
+            assert mine[key].dtype == value.dtype, key
+            assert np.array_equal(mine[key][mask], value[mask]), key
+
+
+def test_same_step_autoreset_is_sync_vector_envs_step_for_step_infos_included():
+    """What Stable-Baselines3 and older libraries expect: the step that ends an episode returns the next
+    one's first observation, the last in infos["final_obs"]."""
+    count, same_step = 3, gymnasium.vector.AutoresetMode.SAME_STEP
+    batched = make_vector(count, autoreset_mode="SameStep")
+    assert batched.metadata["autoreset_mode"] == same_step
+    separate = gymnasium.vector.SyncVectorEnv(
+        [lambda: gymnasium.make(ENV_ID, **KWARGS) for _ in range(count)], autoreset_mode=same_step)
+    assert np.array_equal(batched.reset(seed=7)[0], separate.reset(seed=7)[0])
+    batched.action_space.seed(2)
+    ended = 0
+    for _ in range(50):
+        actions = batched.action_space.sample()
+        got, want = batched.step(actions), separate.step(actions)
+        for mine, theirs in zip(got[:4], want[:4], strict=True):
+            assert mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
+        assert_same_infos(got[4], want[4])
+        ended += int(np.sum(got[2] | got[3]))
+    assert ended >= count
+
+
+def test_an_unknown_autoreset_mode_is_refused():
+    with pytest.raises(ValueError, match="NextStep or SameStep, got Disabled"):
+        make_vector(2, autoreset_mode="Disabled")
