@@ -129,8 +129,10 @@ class NavigationTask:
     def reset(self, rng: np.random.Generator) -> np.ndarray:
         """A new episode drawn from ``rng``; returns the (A, D) first observations."""
         if self.scenario.changes_world:
-            self.sim = Simulation(self.scenario.world(rng, self._base))
-        self.sim.reset(int(rng.integers(SEED_BOUND)))
+            world = self.scenario.world(rng, self._base)
+            self.sim = self._base.with_static_models(world, int(rng.integers(SEED_BOUND)))
+        else:
+            self.sim.reset(int(rng.integers(SEED_BOUND)))
         starts, self.goals = self.scenario.place(self.sim, self.agents, rng)
         for agent, start in zip(self.agents, starts, strict=True):
             self.sim.set_pose(agent, *start)

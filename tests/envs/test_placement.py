@@ -4,6 +4,7 @@ for a scenario that can hold its robots (one that cannot is refused when the env
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -13,8 +14,10 @@ from stage_sim.envs import RobotBody
 from stage_sim.envs.free_space import FreeSpace, PlacementError
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
+from stage_sim.envs.worlds import arena_text, obstacle_models
 from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.loader import load_world_text
 
 SEEDS = 1000
 SMALL = RobotBody(laser_samples=16)
@@ -105,3 +108,22 @@ def test_a_scenario_that_cannot_hold_its_robots_is_refused_when_made() -> None:
     options = ScenarioOptions(scenario="random", n_robots=60, arena_size=4.0, body=SMALL)
     with pytest.raises(PlacementError, match="'random' scenario cannot hold 60 robot"):
         NavigationTask(Scenario(options), TaskConfig())
+
+
+@pytest.mark.parametrize("units", ["", 'unit_length "cm"\nunit_angle "radians"\n'])
+def test_obstacle_models_are_the_models_the_loader_makes_of_their_text(units: str) -> None:
+    boxes = np.column_stack([np.random.default_rng(3).uniform(-14, 14, (40, 2)),
+                             np.random.default_rng(4).uniform(0.3, 1.0, (40, 2)),
+                             np.random.default_rng(5).uniform(-math.pi, math.pi, 40)])
+    text = "".join(
+        f'model( name "obstacle_{i}" size [{w:.4f} {d:.4f} 1] pose [{x:.4f} {y:.4f} 0 {math.degrees(a):.4f}] '
+        'color "DarkSlateGray" obstacle_return 1 )\n' for i, (x, y, w, d, a) in enumerate(boxes))
+    parsed = load_world_text(units + arena_text(30.0) + text, "arena.world")
+    made = obstacle_models(boxes, parsed.settings)
+    assert len(made) == len(boxes)
+    for mine, theirs in zip(made, parsed.models[4:], strict=True):
+        theirs.location = None
+        theirs.blocks = [dataclasses.replace(b, location=None) for b in theirs.blocks]
+        assert [b.points.tolist() for b in mine.blocks] == [b.points.tolist() for b in theirs.blocks]
+        mine.blocks, theirs.blocks = [], []
+        assert mine == theirs
