@@ -12,7 +12,9 @@ refused (Stage's stall). Either ends its episode (terminated); the step limit tr
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cache
 
 import numpy as np
 
@@ -90,6 +92,12 @@ def body_commands(commands: np.ndarray) -> np.ndarray:
     return out
 
 
+def reference_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """(A, 3) body commands for one action per agent, zero for agents whose episode ended (the numpy
+    reference of :func:`stage_sim.envs.step_kernels.commands`)."""
+    return body_commands(action_map.commands(actions) * active[:, None])
+
+
 def step_result(
     outcome: StepOutcome, observations: np.ndarray, distance: np.ndarray, active: np.ndarray, at_limit: np.ndarray,
 ) -> StepResult:
@@ -99,6 +107,29 @@ def step_result(
     truncated = ~terminated & active & at_limit
     return StepResult(observations, outcome.reward * active, terminated, truncated,
                       outcome.arrived & active, outcome.collided & active, distance, active)
+
+
+def finish_step(
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
+    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+) -> StepResult:
+    """The step's result once ``sim`` has moved: observations, rewards from the goal distances ``before`` and
+    ``distance`` (A,), episode ends; agents whose episode ends leave ``active`` (in place). The numpy reference
+    of :func:`stage_sim.envs.step_kernels.finish_step`."""
+    observations = observer.observe(sim, distance, bearing)
+    outcome = score(reward, before, distance, sim.stalled[agents])
+    result = step_result(outcome, observations, distance, active.copy(), at_limit)
+    active &= ~(result.terminated | result.truncated)
+    return result
+
+
+@cache
+def compiled_step() -> tuple[Callable, Callable]:
+    """The compiled twins of :func:`reference_commands` and :func:`finish_step` (numba imported on first use,
+    as for the simulation's compiled kernels), for simulations that run on numba."""
+    from stage_sim.envs import step_kernels
+
+    return step_kernels.commands, step_kernels.finish_step
 
 
 class NavigationTask:
@@ -146,17 +177,14 @@ class NavigationTask:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
-        self.sim.set_velocities(self._agent_rows, body_commands(self.actions.commands(actions) * self.active[:, None]))
+        make_commands, finish = compiled_step() if self.sim.kernels == "numba" else (reference_commands, finish_step)
+        self.sim.set_velocities(self._agent_rows, make_commands(self.actions, actions, self.active))
         self.sim.step()
         self.steps += 1
         before = self.distance
         self.distance, bearing = goal_polar(self.sim.true_poses[self._agent_rows], self.goals)
-        observations = self._observer.observe(self.sim, self.distance, bearing)
-        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self._agent_rows])
-        active = self.active.copy()
-        result = step_result(outcome, observations, self.distance, active, self.steps >= self.config.max_steps)
-        self.active &= ~(result.terminated | result.truncated)
-        return result
+        return finish(self._observer, self.config.reward, self.sim, self._agent_rows, self.distance, bearing, before,
+                      self.active, self.steps >= self.config.max_steps)
 
     def frame(self) -> np.ndarray:
         """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""

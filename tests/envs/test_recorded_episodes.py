@@ -18,6 +18,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stage_sim.backend import KERNELS_ENV
+
 RECORDED = Path(__file__).resolve().parents[1] / "data" / "envs" / "obstacle_episodes.json"
 
 
@@ -129,8 +131,10 @@ CASES: dict[str, Callable[[], dict[str, object]]] = {
 }
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
 @pytest.mark.parametrize("case", list(CASES))
-def test_episodes_replay_as_recorded(case: str) -> None:
+def test_episodes_replay_as_recorded(case: str, kernels: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(KERNELS_ENV, kernels)  # the simulation's kernels and the task's step arithmetic
     recorded = json.loads(RECORDED.read_text())[case]
     assert CASES[case]() == recorded
 
