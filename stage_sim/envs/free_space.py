@@ -52,7 +52,7 @@ class FreeSpace:
         self.resolution = static.resolution
         self.origin = np.asarray(static.origin_xy, dtype=np.float64)
         self.width = static.shape[1]
-        self._index(clearance > self._reach)
+        self._index(clearance > self._reach, sim.kernels == "numba")
 
     def with_world(self, sim: Simulation) -> FreeSpace:
         """The free space of ``sim``, whose world is this one's with more static bodies (an episode's
@@ -75,7 +75,7 @@ class FreeSpace:
             valid[window] &= clearance > self._reach
         space = copy.copy(self)
         space._blocked = blocked
-        space._index(valid)
+        space._index(valid, sim.kernels == "numba")
         return space
 
     def _blocked_of(self, sim: Simulation) -> np.ndarray:
@@ -85,10 +85,16 @@ class FreeSpace:
             blocked |= sim.static.filled_collision_layer(*band)
         return blocked
 
-    def _index(self, valid: np.ndarray) -> None:
-        """Regions and cells of the valid centres ``valid`` (a grid of bools)."""
+    def _index(self, valid: np.ndarray, compiled: bool) -> None:
+        """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
+        compiled twin of scipy's labelling (:mod:`stage_sim.envs.region_kernels`, the same labels)."""
         self._valid = valid
-        self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
+        if compiled:
+            from stage_sim.envs.region_kernels import label8
+
+            self.regions, count = label8(valid)
+        else:
+            self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
         self.cells = np.flatnonzero(valid)
         if count == 1:  # the common case needs no sorting by region
             self._region_cells = [self.cells]
