@@ -22,7 +22,7 @@ from stage_sim.maps.raster import StaticRaster
 from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import RayCaster
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sim.collision import Bodies, GridFrame, place
+from stage_sim.sim.collision import Bodies, GridFrame
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
@@ -139,7 +139,7 @@ class RangerSensing:
         if self._bodies.count:
             robot_cells = self._raster(poses) if body_cells is None else body_cells
         jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
-        origins = place(self._ranger_offset, poses[self._ranger_owner])
+        origins = self._backend.motion.place(self._ranger_offset, self._ranger_owner, poses)
         for group in self._groups:
             chosen = None if ray_due is None else np.flatnonzero(ray_due[group.rays])
             if chosen is None or chosen.size:

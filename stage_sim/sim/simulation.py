@@ -209,7 +209,7 @@ class Simulation:
             silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
-        moving = np.any(self.velocities != 0.0, axis=1)
+        moving = (self.velocities != 0.0).any(axis=1)
         layer = self._updates % 2
         moved, refused, layer_poses = self._collision.resolve(
             self.true_poses, self._layer_poses[layer], self.velocities, dt, moving)
