@@ -11,6 +11,8 @@ for bit (``tests/envs/test_step_kernels.py``). Used when the simulation runs the
 
 from __future__ import annotations
 
+from functools import cache
+
 import numba
 import numpy as np
 
@@ -47,12 +49,19 @@ def finish_step(
     rewards = np.empty(count)
     flags = np.empty((4, count), dtype=np.bool_)
     was_active = active.copy()
-    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
     observe_and_score(ranges, np.float32(observer.layout.range_max), observer.history, sim.velocities, sim.stalled,
                       agents, distance, bearing, observer.tail_low, observer.tail_high, before, active, at_limit,
-                      weights, rows, rewards, flags)
+                      _weights(reward), rows, rewards, flags)
     terminated, truncated, arrived, collided = flags
     return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
+
+
+@cache
+def _weights(reward: RewardConfig) -> np.ndarray:
+    """The reward's weights and tolerance as the kernel takes them (made once per config, not per step)."""
+    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
+    weights.flags.writeable = False
+    return weights
 
 
 @numba.njit(inline="always", **_JIT)
