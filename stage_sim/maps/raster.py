@@ -55,6 +55,10 @@ class StaticBody:
     frame: tuple[float, tuple[float, float], tuple[int, int]] = field(repr=False, compare=False)
     """(resolution, origin, shape) of the grid the cells index."""
 
+    def blocks(self, z_low: float, z_high: float) -> bool:
+        """Whether this body stops a robot whose body spans [z_low, z_high]."""
+        return self.obstacle_return and self.z[0] < z_high and self.z[1] > z_low
+
     @cached_property
     def cells(self) -> np.ndarray:
         """Sorted flat cells of the filled footprint: the outline and the cells whose centre is inside."""
@@ -105,8 +109,7 @@ class StaticRaster:
 
     def collision_tiles(self, z_low: float, z_high: float) -> TileLayer:
         """The cells that block a body spanning [z_low, z_high], in tiles."""
-        flat = [body.outline for body in self.bodies
-                if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low]
+        flat = [body.outline for body in self.bodies if body.blocks(z_low, z_high)]
         return TileLayer.from_cells(self.grid, unique_sorted(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
 
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -129,7 +132,7 @@ class StaticRaster:
         self.grid.check_dense("a dense filled collision layer")
         filled = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
         for body in self.bodies:
-            if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low:
+            if body.blocks(z_low, z_high):
                 filled[body.cells] = True
         return filled.reshape(self.shape)
 
