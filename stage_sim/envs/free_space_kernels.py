@@ -1,10 +1,14 @@
-"""Compiled (numba) twin of ``scipy.ndimage.label`` with 8-connectivity: the regions of free space.
+"""Compiled (numba) twins of free space's two whole-grid steps at an obstacles reset: the regions of the valid
+centres (``scipy.ndimage.label`` with 8-connectivity) and the centres too near an episode's new bodies (what
+:meth:`~stage_sim.envs.free_space.FreeSpace.with_world` finds with distance transforms around them).
 
-Why: an obstacles episode labels the whole grid of valid robot centres once per reset
-(:meth:`stage_sim.envs.free_space.FreeSpace.with_world`), and scipy takes milliseconds on a 30 m world at
-5 cm. One raster pass with a union-find whose roots are always the older provisional label, then labels
-numbered by their region's first cell in raster order, as scipy numbers them: the same array, bit for bit
-(``tests/envs/test_region_kernels.py``). Used when the simulation runs the numba kernels.
+Why: an obstacles episode redoes both once per reset, and scipy takes milliseconds on a 30 m world at 5 cm.
+Labels: one raster pass with a union-find whose roots are always the older provisional label, then labels
+numbered by their region's first cell in raster order, as scipy numbers them. Near cells: every cell within
+the reach of a new cell's disk of offsets, the disk drawn with the very distances scipy's exact transform
+computes (``sqrt(dy² + dx²) · resolution``, compared the same way). Both give the reference's arrays bit for
+bit (``tests/envs/test_free_space_kernels.py``, ``tests/envs/test_placement.py``). Used when the simulation
+runs the numba kernels.
 """
 
 from __future__ import annotations
@@ -85,3 +89,30 @@ def label_into(valid, labels):
         for c in range(width):
             labels[r, c] = final[labels[r, c]]
     return count
+
+
+def clear_near(valid: np.ndarray, added: np.ndarray, cells: np.ndarray, offsets: np.ndarray) -> None:
+    """Clear in ``valid`` (H, W) the flat ``cells`` of ``added`` (H, W) and every cell at one of ``offsets``
+    (K, 2: rows, cols) from one of them. Only the cells with a neighbour not added draw their disk: the cell of
+    ``added`` nearest to any other cell is one of those (a step from an inner cell towards it comes nearer)."""
+    clear_near_into(valid, added, cells, offsets)
+
+
+@numba.njit(**_JIT)
+def clear_near_into(valid, added, cells, offsets):
+    """:func:`clear_near`."""
+    height, width = valid.shape
+    for cell in cells:
+        r, c = cell // width, cell % width
+        valid[r, c] = False
+        inner = 0 < r < height - 1 and 0 < c < width - 1
+        if inner:
+            for dr in (-1, 0, 1):
+                for dc in (-1, 0, 1):
+                    inner = inner and added[r + dr, c + dc]
+        if inner:
+            continue
+        for k in range(offsets.shape[0]):
+            rr, cc = r + offsets[k, 0], c + offsets[k, 1]
+            if 0 <= rr < height and 0 <= cc < width:
+                valid[rr, cc] = False

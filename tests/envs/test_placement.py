@@ -78,14 +78,17 @@ def test_a_thousand_resets_with_fresh_obstacles() -> None:
         check(sim, [0], starts, goals)
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
 @pytest.mark.parametrize("margin", [0.0, 0.1])
-def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obstacles(margin: float) -> None:
-    # What with_world saves (a distance transform of the whole world per episode) must change no answer.
+def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obstacles(margin: float,
+                                                                                      kernels: str) -> None:
+    # What with_world saves (a distance transform of the whole world per episode) must change no answer, with
+    # scipy's transforms and labels (numpy) or their compiled twins (numba).
     scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=12, body=SMALL))
-    base = Simulation(scenario.base, kernels="numba")
+    base = Simulation(scenario.base, kernels=kernels)
     root = FreeSpace(base, [0], margin)
     for seed in range(100):
-        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels="numba")
+        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels=kernels)
         derived, fresh = root.with_world(sim), FreeSpace(sim, [0], margin)
         assert derived.cells.size < root.cells.size
         np.testing.assert_array_equal(derived.regions, fresh.regions)
@@ -127,3 +130,17 @@ def test_obstacle_models_are_the_models_the_loader_makes_of_their_text(units: st
         assert [b.points.tolist() for b in mine.blocks] == [b.points.tolist() for b in theirs.blocks]
         mine.blocks, theirs.blocks = [], []
         assert mine == theirs
+
+
+@pytest.mark.parametrize("options", [
+    ScenarioOptions(world="rooms.world", body=SMALL),
+    ScenarioOptions(scenario="obstacles", n_obstacles=12, arena_size=6.0, body=SMALL),
+], ids=["rooms", "obstacles"])
+def test_the_compiled_free_space_is_scipys(options: ScenarioOptions) -> None:
+    scenario = Scenario(options)
+    bases = {kernels: Simulation(scenario.base, kernels=kernels) for kernels in ("numpy", "numba")}
+    for seed in range(5):
+        world = scenario.world(np.random.default_rng(seed), bases["numpy"])
+        spaces = [FreeSpace(Simulation(world, kernels=kernels), [0], 0.1) for kernels in ("numpy", "numba")]
+        np.testing.assert_array_equal(spaces[0].regions, spaces[1].regions)
+        np.testing.assert_array_equal(spaces[0].cells, spaces[1].cells)
