@@ -1,5 +1,6 @@
 """Compiled (numba) twin of a task step's arithmetic: the commands from the actions, then the observations,
-rewards and episode ends from the simulation's new state, each in one pass over the agents.
+rewards and episode ends from the simulation's new state, each in one pass over the agents (called through
+:func:`stage_sim.envs.task.compiled_commands` and :func:`stage_sim.envs.task.compiled_finish_step`).
 
 Why: with one robot an env step is dominated by the dozens of small numpy calls of the reference
 (:func:`stage_sim.envs.task.reference_commands` and :func:`stage_sim.envs.task.finish_step`), not by
@@ -11,57 +12,10 @@ for bit (``tests/envs/test_step_kernels.py``). Used when the simulation runs the
 
 from __future__ import annotations
 
-from functools import cache
-
 import numba
 import numpy as np
 
-from stage_sim.envs.spaces import ActionMap, ObservationBuilder
-from stage_sim.envs.task import RewardConfig, StepResult
-from stage_sim.sim.simulation import Simulation
-
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
-
-
-def commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """:func:`~stage_sim.envs.task.reference_commands`: (A, 3) body commands, zero for finished agents."""
-    if action_map.discrete:
-        chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
-        out = np.empty((chosen.size, 3))
-        discrete_commands(action_map.table, chosen, active, out)
-    else:
-        wanted = np.asarray(actions, dtype=np.float64).reshape(-1, 2)
-        out = np.empty((wanted.shape[0], 3))
-        continuous_commands(wanted, action_map.low, action_map.high, active, out)
-    return out
-
-
-def finish_step(
-    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
-    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
-) -> StepResult:
-    """:func:`~stage_sim.envs.task.finish_step`: observe, score and end episodes in one compiled pass."""
-    count = agents.size
-    scans = sim.scans
-    ranges = (scans[agents[0]][0].ranges[None] if count == 1
-              else np.stack([scans[agent][0].ranges for agent in agents]))
-    rows = np.empty((count, observer.layout.size), dtype=np.float32)
-    rewards = np.empty(count)
-    flags = np.empty((4, count), dtype=np.bool_)
-    was_active = active.copy()
-    observe_and_score(ranges, np.float32(observer.layout.range_max), observer.history, sim.velocities, sim.stalled,
-                      agents, distance, bearing, observer.tail_low, observer.tail_high, before, active, at_limit,
-                      _weights(reward), rows, rewards, flags)
-    terminated, truncated, arrived, collided = flags
-    return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
-
-
-@cache
-def _weights(reward: RewardConfig) -> np.ndarray:
-    """The reward's weights and tolerance as the kernel takes them (made once per config, not per step)."""
-    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
-    weights.flags.writeable = False
-    return weights
 
 
 @numba.njit(inline="always", **_JIT)

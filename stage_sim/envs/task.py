@@ -12,9 +12,9 @@ refused (Stage's stall). Either ends its episode (terminated); the step limit tr
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cache
+from types import ModuleType
 
 import numpy as np
 
@@ -94,7 +94,7 @@ def body_commands(commands: np.ndarray) -> np.ndarray:
 
 def reference_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
     """(A, 3) body commands for one action per agent, zero for agents whose episode ended (the numpy
-    reference of :func:`stage_sim.envs.step_kernels.commands`)."""
+    reference of :func:`compiled_commands`)."""
     return body_commands(action_map.commands(actions) * active[:, None])
 
 
@@ -115,7 +115,7 @@ def finish_step(
 ) -> StepResult:
     """The step's result once ``sim`` has moved: observations, rewards from the goal distances ``before`` and
     ``distance`` (A,), episode ends; agents whose episode ends leave ``active`` (in place). The numpy reference
-    of :func:`stage_sim.envs.step_kernels.finish_step`."""
+    of :func:`compiled_finish_step`."""
     observations = observer.observe(sim, distance, bearing)
     outcome = score(reward, before, distance, sim.stalled[agents])
     result = step_result(outcome, observations, distance, active.copy(), at_limit)
@@ -124,12 +124,56 @@ def finish_step(
 
 
 @cache
-def compiled_step() -> tuple[Callable, Callable]:
-    """The compiled twins of :func:`reference_commands` and :func:`finish_step` (numba imported on first use,
-    as for the simulation's compiled kernels), for simulations that run on numba."""
+def _kernels() -> ModuleType:
+    """:mod:`stage_sim.envs.step_kernels`, imported on first use (it imports numba), as the simulation's
+    compiled kernels are."""
     from stage_sim.envs import step_kernels
 
-    return step_kernels.commands, step_kernels.finish_step
+    return step_kernels
+
+
+def compiled_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """:func:`reference_commands` in one compiled pass (:mod:`stage_sim.envs.step_kernels`)."""
+    kernels = _kernels()
+    if action_map.discrete:
+        chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
+        out = np.empty((chosen.size, 3))
+        kernels.discrete_commands(action_map.table, chosen, active, out)
+    else:
+        wanted = np.asarray(actions, dtype=np.float64).reshape(-1, 2)
+        out = np.empty((wanted.shape[0], 3))
+        kernels.continuous_commands(wanted, action_map.low, action_map.high, active, out)
+    return out
+
+
+def compiled_finish_step(
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
+    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+) -> StepResult:
+    """:func:`finish_step` in one compiled pass: observe, score and end episodes (goal distance and bearing
+    come from numpy, :func:`~stage_sim.envs.spaces.goal_polar`)."""
+    count = agents.size
+    scans = sim.scans
+    ranges = (scans[agents[0]][0].ranges[None] if count == 1
+              else np.stack([scans[agent][0].ranges for agent in agents]))
+    rows = np.empty((count, observer.layout.size), dtype=np.float32)
+    rewards = np.empty(count)
+    flags = np.empty((4, count), dtype=np.bool_)
+    was_active = active.copy()
+    _kernels().observe_and_score(
+        ranges, np.float32(observer.layout.range_max), observer.history, sim.velocities, sim.stalled, agents, distance,
+        bearing, observer.tail_low, observer.tail_high, before, active, at_limit, _weights(reward), rows, rewards,
+        flags)
+    terminated, truncated, arrived, collided = flags
+    return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
+
+
+@cache
+def _weights(reward: RewardConfig) -> np.ndarray:
+    """The reward's weights and tolerance as the kernel takes them (made once per config, not per step)."""
+    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
+    weights.flags.writeable = False
+    return weights
 
 
 class NavigationTask:
@@ -177,7 +221,9 @@ class NavigationTask:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
-        make_commands, finish = compiled_step() if self.sim.kernels == "numba" else (reference_commands, finish_step)
+        compiled = self.sim.kernels == "numba"
+        make_commands = compiled_commands if compiled else reference_commands
+        finish = compiled_finish_step if compiled else finish_step
         self.sim.set_velocities(self._agent_rows, make_commands(self.actions, actions, self.active))
         self.sim.step()
         self.steps += 1

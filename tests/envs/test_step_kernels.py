@@ -9,9 +9,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from stage_sim.envs import step_kernels
 from stage_sim.envs.spaces import TAIL, ActionMap, ObservationBuilder, ObservationLayout
-from stage_sim.envs.task import RewardConfig, finish_step, reference_commands
+from stage_sim.envs.task import (
+    RewardConfig,
+    compiled_commands,
+    compiled_finish_step,
+    finish_step,
+    reference_commands,
+)
 
 AGENTS = 5
 BEAMS = 16
@@ -35,7 +40,7 @@ def test_commands_match_the_reference(discrete: bool) -> None:
             actions = rng.uniform(-3, 3, (AGENTS, 2)).astype(rng.choice([np.float32, np.float64]))
             actions.flat[rng.integers(0, actions.size, 3)] = rng.choice([-0.0, 0.0, np.nan, 1.0, -1.0], 3)
         active = rng.random(AGENTS) < 0.7
-        assert same(step_kernels.commands(action_map, actions, active), reference_commands(action_map, actions, active))
+        assert same(compiled_commands(action_map, actions, active), reference_commands(action_map, actions, active))
 
 
 def test_observations_rewards_and_ends_match_the_reference() -> None:
@@ -60,7 +65,7 @@ def test_observations_rewards_and_ends_match_the_reference() -> None:
             active[:] = True
         mine_active, their_active = active.copy(), active.copy()
         at_limit = step % 7 == 0
-        mine = step_kernels.finish_step(compiled, reward, sim, agents, distance, bearing, before, mine_active, at_limit)
+        mine = compiled_finish_step(compiled, reward, sim, agents, distance, bearing, before, mine_active, at_limit)
         theirs = finish_step(reference, reward, sim, agents, distance, bearing, before, their_active, at_limit)
         for field in ("observations", "rewards", "terminated", "truncated", "arrived", "collided", "distance",
                       "active"):
