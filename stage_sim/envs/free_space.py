@@ -27,6 +27,8 @@ from stage_sim.sim.simulation import Simulation
 #: Candidates drawn per batch, and batches tried, before every valid cell is looked at.
 BATCH = 64
 QUICK_BATCHES = 4
+#: Side (cells) of the blocks in which :func:`_clusters` looks for new bodies.
+CLUSTER_BLOCK = 32
 
 
 class PlacementError(ValueError):
@@ -41,16 +43,26 @@ class FreeSpace:
         static.grid.check_dense("placing robots in free space (a distance transform of the whole world)")
         self._robots = robots
         self._margin = margin
+        self._bodies = list(static.bodies)
         self._blocked = self._blocked_of(sim)
-        padded = np.pad(self._blocked, 1, constant_values=True)
-        clearance = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution
         self.radius = max(sim.robots[i].radius for i in robots)
         self._reach = self.radius + margin + static.resolution
         """A valid centre is farther than this (m) from every blocking cell."""
         self.resolution = static.resolution
+        self._pad = int(self._reach / self.resolution) + 1
+        """Cells around a blocking cell that can be within the reach of it."""
         self.origin = np.asarray(static.origin_xy, dtype=np.float64)
         self.width = static.shape[1]
-        self._index(clearance > self._reach)
+        padded = np.pad(self._blocked, 1, constant_values=True)  # the grid's edge blocks too
+        if sim.kernels == "numba":
+            from stage_sim.envs.free_space_kernels import clear_near
+
+            valid = np.ones(padded.shape, dtype=bool)
+            clear_near(valid, padded, np.flatnonzero(padded), self._near_offsets(self._pad))
+            valid = np.ascontiguousarray(valid[1:-1, 1:-1])
+        else:
+            valid = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution > self._reach
+        self._index(valid, sim.kernels == "numba")
 
     def with_world(self, sim: Simulation) -> FreeSpace:
         """The free space of ``sim``, whose world is this one's with more static bodies (an episode's
@@ -60,22 +72,35 @@ class FreeSpace:
         static = sim.static
         same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
-        blocked = self._blocked_of(sim) if same_grid else None
+        blocked = self._blocked_with(sim) if same_grid else None
         if blocked is None or (self._blocked & ~blocked).any():
             return FreeSpace(sim, self._robots, self._margin)
         added = blocked & ~self._blocked
         valid = self._valid.copy()
-        pad = int(self._reach / self.resolution) + 1
-        groups, _ = ndimage.label(added)
-        for rows, cols in ndimage.find_objects(groups):
-            window = (slice(max(rows.start - pad, 0), rows.stop + pad),
-                      slice(max(cols.start - pad, 0), cols.stop + pad))
-            clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
-            valid[window] &= clearance > self._reach
+        pad = self._pad
+        if sim.kernels == "numba":
+            from stage_sim.envs.free_space_kernels import clear_near
+
+            clear_near(valid, added, np.flatnonzero(added), self._near_offsets(pad))
+        else:
+            for rows, cols in _clusters(added):
+                window = (slice(max(rows.start - pad, 0), rows.stop + pad),
+                          slice(max(cols.start - pad, 0), cols.stop + pad))
+                clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
+                valid[window] &= clearance > self._reach
         space = copy.copy(self)
+        space._bodies = list(static.bodies)
         space._blocked = blocked
-        space._index(valid)
+        space._index(valid, sim.kernels == "numba")
         return space
+
+    def _near_offsets(self, pad: int) -> np.ndarray:
+        """(K, 2) offsets (rows, cols) of the cells no farther than the reach from a cell, by the distance a
+        distance transform computes (``sqrt(dy² + dx²)`` cells times the resolution); ``pad`` bounds them."""
+        rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
+        distance = np.sqrt((rows * rows + cols * cols).astype(np.float64)) * self.resolution
+        near = ~(distance > self._reach)
+        return np.ascontiguousarray(np.column_stack([rows[near], cols[near]]).astype(np.int64))
 
     def _blocked_of(self, sim: Simulation) -> np.ndarray:
         """Cells no part of a robot may cover: the filled bodies of every height band of the robots."""
@@ -84,10 +109,30 @@ class FreeSpace:
             blocked |= sim.static.filled_collision_layer(*band)
         return blocked
 
-    def _index(self, valid: np.ndarray) -> None:
-        """Regions and cells of the valid centres ``valid`` (a grid of bools)."""
+    def _blocked_with(self, sim: Simulation) -> np.ndarray:
+        """:meth:`_blocked_of` ``sim`` (on this grid): this world's blocked cells and those of the bodies added
+        after this world's when its bodies come first, the very objects (an episode's world,
+        :meth:`~stage_sim.sim.simulation.Simulation.with_static_models`), else worked out anew."""
+        bodies = sim.static.bodies
+        if len(bodies) < len(self._bodies) or any(a is not b for a, b in zip(self._bodies, bodies, strict=False)):
+            return self._blocked_of(sim)
+        bands = {sim.robots[i].z_band for i in self._robots}
+        blocked = self._blocked.copy()
+        for body in bodies[len(self._bodies):]:
+            if any(body.blocks(*band) for band in bands):
+                blocked.ravel()[body.cells] = True
+        return blocked
+
+    def _index(self, valid: np.ndarray, compiled: bool) -> None:
+        """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
+        compiled twin of scipy's labelling (:mod:`stage_sim.envs.free_space_kernels`, the same labels)."""
         self._valid = valid
-        self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
+        if compiled:
+            from stage_sim.envs.free_space_kernels import label8
+
+            self.regions, count = label8(valid)
+        else:
+            self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
         self.cells = np.flatnonzero(valid)
         if count == 1:  # the common case needs no sorting by region
             self._region_cells = [self.cells]
@@ -166,6 +211,28 @@ class FreeSpace:
         if excluded:
             return np.concatenate([c for r, c in enumerate(self._region_cells, 1) if r not in excluded] or [[]])
         return self.cells
+
+
+def _clusters(mask: np.ndarray) -> list[tuple[slice, slice]]:
+    """Boxes (rows, cols) that hold every set cell of ``mask`` between them, one per 8-connected group of the
+    :data:`CLUSTER_BLOCK`-cell blocks holding one, each cut to its cells: the places an episode's obstacles
+    changed, found without labelling the whole grid (how cells are grouped changes no answer of
+    :meth:`FreeSpace.with_world`, only the size of its windows)."""
+    rows, cols = np.divmod(np.flatnonzero(mask), mask.shape[1])  # np.nonzero of a 2-D grid is ten times slower
+    if rows.size == 0:
+        return []
+    shape = (rows.max() // CLUSTER_BLOCK + 1, cols.max() // CLUSTER_BLOCK + 1)
+    blocks = np.zeros(shape, dtype=bool)
+    blocks[rows // CLUSTER_BLOCK, cols // CLUSTER_BLOCK] = True
+    groups, _ = ndimage.label(blocks, structure=np.ones((3, 3), dtype=bool))
+    boxes = []
+    for block_rows, block_cols in ndimage.find_objects(groups):
+        window = (slice(block_rows.start * CLUSTER_BLOCK, block_rows.stop * CLUSTER_BLOCK),
+                  slice(block_cols.start * CLUSTER_BLOCK, block_cols.stop * CLUSTER_BLOCK))
+        held_rows = np.flatnonzero(mask[window].any(axis=1)) + window[0].start
+        held_cols = np.flatnonzero(mask[window].any(axis=0)) + window[1].start
+        boxes.append((slice(held_rows[0], held_rows[-1] + 1), slice(held_cols[0], held_cols[-1] + 1)))
+    return boxes
 
 
 class _Fits:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.envs.free_space import FreeSpace, PlacementError
-from stage_sim.envs.worlds import RobotBody, WorldSource, obstacles_text, robots_text, world_centre
+from stage_sim.envs.worlds import RobotBody, WorldSource, obstacle_models, robots_text, world_centre
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.description import WorldDescription
 
@@ -69,9 +69,8 @@ class Scenario:
         self.source = WorldSource.of(options.world, arena, options.resolution)
         plain = self.source.load()
         generated = options.n_robots if options.n_robots is not None else (0 if plain.robots() else 1)
-        self._robots = robots_text(generated, options.body, world_centre(plain)) if generated else ""
-        description = self._load("") if generated else plain
-        self.base = description
+        robots = robots_text(generated, options.body, world_centre(plain)) if generated else ""
+        self.base = self.source.load(robots, bool(options.n_robots)) if generated else plain
         self._base_space: FreeSpace | None = None
         self._space: tuple[Simulation, FreeSpace] | None = None
         self._root_space: FreeSpace | None = None
@@ -93,7 +92,7 @@ class Scenario:
             boxes[i, :2] = self._base_space.draw(rng, boxes[:i, :2], high)
             boxes[i, 2:4] = rng.uniform(low, high, 2)
             boxes[i, 4] = rng.uniform(-math.pi, math.pi)
-        return self._load(obstacles_text(boxes))
+        return self.source.add(self.base, obstacle_models(boxes, self.base.settings), bool(self.options.n_robots))
 
     def place(
         self, sim: Simulation, agents: list[int], rng: np.random.Generator
@@ -131,6 +130,3 @@ class Scenario:
         goals = -on_circle + rng.uniform(-jitter, jitter, (count, 2))
         heading = np.arctan2(goals[:, 1] - starts_xy[:, 1], goals[:, 0] - starts_xy[:, 0])
         return np.column_stack([starts_xy, heading]), goals
-
-    def _load(self, extra: str) -> WorldDescription:
-        return self.source.load(self._robots + extra, replace_robots=bool(self.options.n_robots))

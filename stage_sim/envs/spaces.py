@@ -93,14 +93,16 @@ class ObservationBuilder:
         self.layout = layout
         self.agents = np.asarray(agents, dtype=np.int64)
         # A goal beyond the world's diagonal cannot happen; clipping the tail to the spaces is a guard.
-        self._tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float32)
-        self._tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float32)
-        self._history = np.zeros((len(agents), layout.history, layout.beams), dtype=np.float32)
+        self.tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float32)
+        self.tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float32)
+        self.history = np.zeros((len(agents), layout.history, layout.beams), dtype=np.float32)
+        """(A, k, B) normalised scans, oldest first (the compiled step, :mod:`stage_sim.envs.step_kernels`,
+        shifts them too)."""
 
     def reset(self, sim: Simulation) -> None:
         """Fill every agent's history with its current scan (no older scan exists yet)."""
-        self._normalise(self._ranges(sim), self._history[:, -1])
-        self._history[:, :-1] = self._history[:, -1:]
+        self._normalise(self._ranges(sim), self.history[:, -1])
+        self.history[:, :-1] = self.history[:, -1:]
 
     def observe(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         """Shift in the current scans and return (A, D) observations (goal distance and bearing given)."""
@@ -111,14 +113,14 @@ class ObservationBuilder:
     ) -> np.ndarray:
         """:meth:`observe` from the agents' newest ranges (A, B) and velocities (A, 3), wherever they come
         from (one simulation, or one per world in the vector env)."""
-        self._history[:, :-1] = self._history[:, 1:]
-        self._normalise(ranges, self._history[:, -1])
+        self.history[:, :-1] = self.history[:, 1:]
+        self._normalise(ranges, self.history[:, -1])
         return self._rows(velocity, distance, bearing)
 
     def restore(self, row: int, observation: np.ndarray) -> None:
         """Take row ``row``'s scan history from an observation (the first one of a world reset elsewhere)."""
         scans = self.layout.history * self.layout.beams
-        self._history[row] = observation[:scans].reshape(self.layout.history, self.layout.beams)
+        self.history[row] = observation[:scans].reshape(self.layout.history, self.layout.beams)
 
     def rows(self, sim: Simulation, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         """(A, D) observations from the kept history, the goals' distance and bearing and the velocities."""
@@ -127,10 +129,10 @@ class ObservationBuilder:
     def _rows(self, velocity: np.ndarray, distance: np.ndarray, bearing: np.ndarray) -> np.ndarray:
         count, scans = len(self.agents), self.layout.history * self.layout.beams
         rows = np.empty((count, scans + TAIL), dtype=np.float32)
-        rows[:, :scans] = self._history.reshape(count, scans)
+        rows[:, :scans] = self.history.reshape(count, scans)
         tail = rows[:, scans:]
         tail[:, 0], tail[:, 1], tail[:, 2], tail[:, 3] = distance, bearing, velocity[:, 0], velocity[:, 2]
-        np.clip(tail, self._tail_low, self._tail_high, out=tail)
+        np.clip(tail, self.tail_low, self.tail_high, out=tail)
         return rows
 
     def _ranges(self, sim: Simulation) -> np.ndarray:

@@ -13,6 +13,8 @@ refused (Stage's stall). Either ends its episode (terminated); the step limit tr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cache
+from types import ModuleType
 
 import numpy as np
 
@@ -90,6 +92,12 @@ def body_commands(commands: np.ndarray) -> np.ndarray:
     return out
 
 
+def reference_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """(A, 3) body commands for one action per agent, zero for agents whose episode ended (the numpy
+    reference of :func:`compiled_commands`)."""
+    return body_commands(action_map.commands(actions) * active[:, None])
+
+
 def step_result(
     outcome: StepOutcome, observations: np.ndarray, distance: np.ndarray, active: np.ndarray, at_limit: np.ndarray,
 ) -> StepResult:
@@ -99,6 +107,73 @@ def step_result(
     truncated = ~terminated & active & at_limit
     return StepResult(observations, outcome.reward * active, terminated, truncated,
                       outcome.arrived & active, outcome.collided & active, distance, active)
+
+
+def finish_step(
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
+    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+) -> StepResult:
+    """The step's result once ``sim`` has moved: observations, rewards from the goal distances ``before`` and
+    ``distance`` (A,), episode ends; agents whose episode ends leave ``active`` (in place). The numpy reference
+    of :func:`compiled_finish_step`."""
+    observations = observer.observe(sim, distance, bearing)
+    outcome = score(reward, before, distance, sim.stalled[agents])
+    result = step_result(outcome, observations, distance, active.copy(), at_limit)
+    active &= ~(result.terminated | result.truncated)
+    return result
+
+
+@cache
+def _kernels() -> ModuleType:
+    """:mod:`stage_sim.envs.step_kernels`, imported on first use (it imports numba), as the simulation's
+    compiled kernels are."""
+    from stage_sim.envs import step_kernels
+
+    return step_kernels
+
+
+def compiled_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """:func:`reference_commands` in one compiled pass (:mod:`stage_sim.envs.step_kernels`)."""
+    kernels = _kernels()
+    if action_map.discrete:
+        chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
+        out = np.empty((chosen.size, 3))
+        kernels.discrete_commands(action_map.table, chosen, active, out)
+    else:
+        wanted = np.asarray(actions, dtype=np.float64).reshape(-1, 2)
+        out = np.empty((wanted.shape[0], 3))
+        kernels.continuous_commands(wanted, action_map.low, action_map.high, active, out)
+    return out
+
+
+def compiled_finish_step(
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
+    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+) -> StepResult:
+    """:func:`finish_step` in one compiled pass: observe, score and end episodes (goal distance and bearing
+    come from numpy, :func:`~stage_sim.envs.spaces.goal_polar`)."""
+    count = agents.size
+    scans = sim.scans
+    ranges = (scans[agents[0]][0].ranges[None] if count == 1
+              else np.stack([scans[agent][0].ranges for agent in agents]))
+    rows = np.empty((count, observer.layout.size), dtype=np.float32)
+    rewards = np.empty(count)
+    flags = np.empty((4, count), dtype=np.bool_)
+    was_active = active.copy()
+    _kernels().observe_and_score(
+        ranges, np.float32(observer.layout.range_max), observer.history, sim.velocities, sim.stalled, agents, distance,
+        bearing, observer.tail_low, observer.tail_high, before, active, at_limit, _weights(reward), rows, rewards,
+        flags)
+    terminated, truncated, arrived, collided = flags
+    return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
+
+
+@cache
+def _weights(reward: RewardConfig) -> np.ndarray:
+    """The reward's weights and tolerance as the kernel takes them (made once per config, not per step)."""
+    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
+    weights.flags.writeable = False
+    return weights
 
 
 class NavigationTask:
@@ -129,8 +204,10 @@ class NavigationTask:
     def reset(self, rng: np.random.Generator) -> np.ndarray:
         """A new episode drawn from ``rng``; returns the (A, D) first observations."""
         if self.scenario.changes_world:
-            self.sim = Simulation(self.scenario.world(rng, self._base))
-        self.sim.reset(int(rng.integers(SEED_BOUND)))
+            world = self.scenario.world(rng, self._base)
+            self.sim = self._base.with_static_models(world, int(rng.integers(SEED_BOUND)))
+        else:
+            self.sim.reset(int(rng.integers(SEED_BOUND)))
         starts, self.goals = self.scenario.place(self.sim, self.agents, rng)
         for agent, start in zip(self.agents, starts, strict=True):
             self.sim.set_pose(agent, *start)
@@ -144,17 +221,16 @@ class NavigationTask:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
-        self.sim.set_velocities(self._agent_rows, body_commands(self.actions.commands(actions) * self.active[:, None]))
+        compiled = self.sim.kernels == "numba"
+        make_commands = compiled_commands if compiled else reference_commands
+        finish = compiled_finish_step if compiled else finish_step
+        self.sim.set_velocities(self._agent_rows, make_commands(self.actions, actions, self.active))
         self.sim.step()
         self.steps += 1
         before = self.distance
         self.distance, bearing = goal_polar(self.sim.true_poses[self._agent_rows], self.goals)
-        observations = self._observer.observe(self.sim, self.distance, bearing)
-        outcome = score(self.config.reward, before, self.distance, self.sim.stalled[self._agent_rows])
-        active = self.active.copy()
-        result = step_result(outcome, observations, self.distance, active, self.steps >= self.config.max_steps)
-        self.active &= ~(result.terminated | result.truncated)
-        return result
+        return finish(self._observer, self.config.reward, self.sim, self._agent_rows, self.distance, bearing, before,
+                      self.active, self.steps >= self.config.max_steps)
 
     def frame(self) -> np.ndarray:
         """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""

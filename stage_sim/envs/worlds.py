@@ -2,8 +2,9 @@
 
 Generated worlds go through :func:`load_world_text` like any file a user writes, so they are checked,
 rasterised, simulated and rendered by the same code. A user's own ``.world`` can be extended the same
-way: its text with generated robots and obstacles appended, loaded as if it were that file (includes and
-bitmaps resolve from its folder).
+way: its text with generated robots appended, loaded as if it were that file (includes and bitmaps
+resolve from its folder). An episode's obstacles, made anew at every reset, skip the text: they are the
+very models the loader would make of it (:func:`obstacle_models`), added to the loaded world.
 """
 
 from __future__ import annotations
@@ -15,13 +16,15 @@ from pathlib import Path
 import numpy as np
 
 from stage_sim.worldfile.bundled import find_world
-from stage_sim.worldfile.description import WorldDescription
-from stage_sim.worldfile.loader import load_world, load_world_text
+from stage_sim.worldfile.colors import x11_color
+from stage_sim.worldfile.description import Block, Model, Pose, WorldDescription, WorldSettings
+from stage_sim.worldfile.loader import UNIT_SQUARE, load_world, load_world_text
 from stage_sim.worldfile.syntax import read_text_file
 
 #: Corners of the polygon that stands for a round robot body (Stage scales it to the model size).
 DISC_CORNERS = 12
 ROBOT_DEFINE = "rl_robot"
+OBSTACLE_COLOR = "DarkSlateGray"
 
 
 @dataclass(frozen=True)
@@ -88,13 +91,21 @@ def world_centre(description: WorldDescription) -> tuple[float, float]:
     return (float(low_x + high_x) / 2, float(low_y + high_y) / 2)
 
 
-def obstacles_text(boxes: np.ndarray) -> str:
-    """Static boxes, one row (x, y, width, depth, yaw) each, as ordinary obstacle models."""
-    return "".join(
-        f'model( name "obstacle_{i}" size [{w:.4f} {d:.4f} 1] pose [{x:.4f} {y:.4f} 0 {math.degrees(a):.4f}] '
-        'color "DarkSlateGray" obstacle_return 1 )\n'
-        for i, (x, y, w, d, a) in enumerate(np.asarray(boxes).reshape(-1, 5))
-    )
+def obstacle_models(boxes: np.ndarray, settings: WorldSettings) -> list[Model]:
+    """Static boxes, one row (x, y, width, depth, yaw) each, as ordinary obstacle models: the models the loader
+    makes of ``model( name "obstacle_<i>" size [w d 1] pose [x y 0 yaw°] color "DarkSlateGray"
+    obstacle_return 1 )`` appended to the world's text, without writing or parsing it (a reset builds one
+    world per episode). Like that text they hold 4 decimals (yaw in degrees) and are read in the world's units."""
+    length, angle = settings.unit_length, settings.unit_angle
+    color = x11_color(OBSTACLE_COLOR)
+    models = []
+    for i, (x, y, w, d, a) in enumerate(np.asarray(boxes).reshape(-1, 5)):
+        x, y, w, d, yaw = (float(f"{value:.4f}") for value in (x, y, w, d, math.degrees(a)))
+        models.append(Model(
+            type="model", name=f"obstacle_{i}", pose=Pose(x * length, y * length, 0.0 * length, yaw * angle),
+            size=(w * length, d * length, 1.0 * length), color=color,
+            blocks=[Block(UNIT_SQUARE.copy(), (0.0, 1.0), None)], obstacle_return=True))
+    return models
 
 
 @dataclass(frozen=True)
@@ -124,6 +135,17 @@ class WorldSource:
             generated = [m for m in description.models if m.type == "position" and m.name.startswith("agent_")]
             description.models = [m for m in description.models if m.type != "position"] + generated
         return description
+
+    @staticmethod
+    def add(description: WorldDescription, models: list[Model], replace_robots: bool = False) -> WorldDescription:
+        """A loaded world (:meth:`load`) with ``models`` added where the text written after the file's would put
+        them: after its models, before the generated robots that ``replace_robots`` moves to the end."""
+        if replace_robots:
+            ordered = [m for m in description.models if m.type != "position"] + models
+            ordered += [m for m in description.models if m.type == "position"]
+        else:
+            ordered = [*description.models, *models]
+        return WorldDescription(description.path, description.settings, ordered, list(description.warnings))
 
 
 def _robot_color(index: int) -> str:

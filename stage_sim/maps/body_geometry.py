@@ -75,6 +75,11 @@ def body_frame(model: Model, pose: Pose) -> Pose:
 
 def global_poses(description: WorldDescription) -> dict[int, Pose]:
     """Global pose of every model, keyed by ``id(model)`` (models are plain mutable dataclasses)."""
+    return tree_poses(description.models)
+
+
+def tree_poses(models: list[Model]) -> dict[int, Pose]:
+    """:func:`global_poses` of the top-level ``models`` and their subtrees only (models added to a world)."""
     poses: dict[int, Pose] = {}
 
     def visit(model: Model, parent: Pose | None, parent_model: Model | None) -> None:
@@ -87,7 +92,7 @@ def global_poses(description: WorldDescription) -> dict[int, Pose]:
         for child in model.children:
             visit(child, pose, model)
 
-    for top in description.models:
+    for top in models:
         visit(top, None, None)
     return poses
 

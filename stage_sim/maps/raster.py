@@ -30,7 +30,7 @@ from itertools import groupby
 
 import numpy as np
 
-from stage_sim.maps.body_geometry import body_frame, body_shape, global_poses, transform_points
+from stage_sim.maps.body_geometry import body_frame, body_shape, transform_points, tree_poses
 from stage_sim.maps.polygon_raster import edge_cells, fill_cells, vertex_cells
 from stage_sim.maps.tiles import DENSE_CELL_LIMIT, CellValues, TileGrid, TileLayer, WorldTooLargeError, unique_sorted
 from stage_sim.worldfile.description import Model, WorldDescription
@@ -54,6 +54,10 @@ class StaticBody:
     polygons: list[np.ndarray] = field(repr=False, compare=False)
     frame: tuple[float, tuple[float, float], tuple[int, int]] = field(repr=False, compare=False)
     """(resolution, origin, shape) of the grid the cells index."""
+
+    def blocks(self, z_low: float, z_high: float) -> bool:
+        """Whether this body stops a robot whose body spans [z_low, z_high]."""
+        return self.obstacle_return and self.z[0] < z_high and self.z[1] > z_low
 
     @cached_property
     def cells(self) -> np.ndarray:
@@ -105,8 +109,7 @@ class StaticRaster:
 
     def collision_tiles(self, z_low: float, z_high: float) -> TileLayer:
         """The cells that block a body spanning [z_low, z_high], in tiles."""
-        flat = [body.outline for body in self.bodies
-                if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low]
+        flat = [body.outline for body in self.bodies if body.blocks(z_low, z_high)]
         return TileLayer.from_cells(self.grid, unique_sorted(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
 
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -129,7 +132,7 @@ class StaticRaster:
         self.grid.check_dense("a dense filled collision layer")
         filled = np.zeros(self.shape[0] * self.shape[1], dtype=bool)
         for body in self.bodies:
-            if body.obstacle_return and body.z[0] < z_high and body.z[1] > z_low:
+            if body.blocks(z_low, z_high):
                 filled[body.cells] = True
         return filled.reshape(self.shape)
 
@@ -178,7 +181,7 @@ def build_static_raster(
 ) -> StaticRaster:
     """Rasterise every static model of the world; ``keep_inside`` adds (x, y, radius) discs to the extent."""
     resolution = description.settings.resolution
-    shapes = _world_shapes(description)
+    shapes = _world_shapes(description.models)
     vertices = [vertex_cells(part.points, resolution) for part in shapes]
     outlines = [edge_cells([v]) for v in vertices]
     corners = [np.zeros((0, 2), dtype=np.int64), *vertices, *outlines]
@@ -188,16 +191,44 @@ def build_static_raster(
     low, high = (stacked.min(axis=0), stacked.max(axis=0)) if len(stacked) else (np.zeros(2, int), np.ones(2, int))
     shape = (int(high[1] - low[1]) + 1, int(high[0] - low[0]) + 1)
     origin = (float(low[0]) * resolution, float(low[1]) * resolution)
+    bodies = _static_bodies(shapes, outlines, low, (resolution, origin, shape))
+    return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
+
+
+def with_models(raster: StaticRaster, models: list[Model]) -> StaticRaster | None:
+    """The raster of a world that is ``raster``'s with the top-level ``models`` appended (an episode's
+    obstacles): the bodies already rasterised are shared, only the new ones are traced. It is the one
+    :func:`build_static_raster` makes of that world while every new cell lies on the grid; None when one
+    does not (the grid would grow, and everything be placed anew)."""
+    shapes = _world_shapes(models)
+    vertices = [vertex_cells(part.points, raster.resolution) for part in shapes]
+    outlines = [edge_cells([v]) for v in vertices]
+    low = np.array([round(raster.origin_xy[0] / raster.resolution), round(raster.origin_xy[1] / raster.resolution)])
+    high = low + np.array(raster.shape[::-1]) - 1
+    stacked = np.concatenate([np.zeros((0, 2), dtype=np.int64), *vertices, *outlines])
+    if len(stacked) and ((stacked.min(axis=0) < low).any() or (stacked.max(axis=0) > high).any()):
+        return None
+    frame = (raster.resolution, raster.origin_xy, raster.shape)
+    bodies = [*raster.bodies, *_static_bodies(shapes, outlines, low, frame)]
+    return StaticRaster(shape=raster.shape, resolution=raster.resolution, origin_xy=raster.origin_xy, bodies=bodies)
+
+
+def _static_bodies(
+    shapes: list[_Placed], outlines: list[np.ndarray], low: np.ndarray,
+    frame: tuple[float, tuple[float, float], tuple[int, int]],
+) -> list[StaticBody]:
+    """One body per shape (the polygons of a model's shape group), its outline cells on the grid whose world
+    cell ``low`` is its (0, 0) and whose ``frame`` is (resolution, origin, shape)."""
+    width = frame[2][1]
     bodies = []
-    frame = (resolution, origin, shape)
     for _, members in groupby(zip(shapes, outlines, strict=True), key=lambda item: (id(item[0].model), item[0].group)):
         parts = list(members)
         shape_of, cells = parts[0][0], np.concatenate([cells for _, cells in parts]) - low
-        outline = unique_sorted(cells[:, 1] * shape[1] + cells[:, 0])
+        outline = unique_sorted(cells[:, 1] * width + cells[:, 0])
         model = shape_of.model
         bodies.append(StaticBody(model.name, outline, shape_of.z, model.ranger_return, model.obstacle_return,
                                  [part.points for part, _ in parts], frame))
-    return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
+    return bodies
 
 
 def static_outline_summary(description: WorldDescription) -> dict[str, object]:
@@ -205,7 +236,7 @@ def static_outline_summary(description: WorldDescription) -> dict[str, object]:
 
     What ``stage_sim inspect`` reports: a world of any size and resolution is summarised in the time its
     outlines take to trace, never in memory proportional to its area."""
-    shapes = _world_shapes(description)
+    shapes = _world_shapes(description.models)
     points = np.concatenate([part.points for part in shapes]) if shapes else np.zeros((0, 2))
     extent = [*points.min(axis=0), *points.max(axis=0)] if len(points) else None
     models = len({id(part.model) for part in shapes})
@@ -222,11 +253,12 @@ class _Placed:
     group: int
 
 
-def _world_shapes(description: WorldDescription) -> list[_Placed]:
-    """Every static polygon placed in the world, the polygons of one shape next to each other."""
-    poses = global_poses(description)
+def _world_shapes(models: list[Model]) -> list[_Placed]:
+    """Every static polygon of the top-level ``models`` and their subtrees placed in the world, the polygons
+    of one shape next to each other."""
+    poses = tree_poses(models)
     placed = []
-    for model in _static_models(description):
+    for model in _static_models(models):
         pose = poses[id(model)]
         frame = body_frame(model, pose)
         top = pose.z + model.origin.z
@@ -236,7 +268,7 @@ def _world_shapes(description: WorldDescription) -> list[_Placed]:
     return placed
 
 
-def _static_models(description: WorldDescription) -> list[Model]:
+def _static_models(models: list[Model]) -> list[Model]:
     found: list[Model] = []
 
     def visit(model: Model, inside_robot: bool) -> None:
@@ -245,6 +277,6 @@ def _static_models(description: WorldDescription) -> list[Model]:
         for child in model.children:
             visit(child, inside_robot or model.type == "position")
 
-    for top in description.models:
+    for top in models:
         visit(top, False)
     return found

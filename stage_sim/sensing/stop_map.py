@@ -38,13 +38,16 @@ class StopMap:
 
     def __init__(self, slots: np.ndarray) -> None:
         self._slots = slots
+        self._largest: int | None = None  # the widest margin allowed, asked at every cast: worked out at the first
         self.pad = -1  #: regions of margin on each side (-1: not built yet)
         self.cells = np.zeros((1, 1), dtype=np.uint8)  #: (R + 2·pad, C + 2·pad) 1 where a jump stops
 
     def fitted(self, reach_cells: float) -> tuple[np.ndarray, int]:
         """(map, pad) with a margin for beams of up to ``reach_cells`` cells (rebuilt only to grow it)."""
         rows, cols = self._slots.shape
-        want = min(int(1.5 * reach_cells) // TILE + _SPARE, _largest_pad(rows, cols))
+        if self._largest is None:
+            self._largest = _largest_pad(rows, cols)
+        want = min(int(1.5 * reach_cells) // TILE + _SPARE, self._largest)
         if want > self.pad:
             cells = np.zeros((rows + 2 * want, cols + 2 * want), dtype=np.uint8)
             cells[want:want + rows, want:want + cols] = self._slots >= 0

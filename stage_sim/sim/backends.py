@@ -27,7 +27,7 @@ import numpy as np
 from stage_sim.backend import KERNELS
 from stage_sim.maps.tiles import CellValues, TileLayer
 from stage_sim.sensing.casters import RayCaster, make_caster
-from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame
+from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame, place
 from stage_sim.sim.drives import DriveGroup
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import integrate_odometry
@@ -61,6 +61,11 @@ class Motion(Protocol):
         """Odometry after the step: integrated with the errors for robots that ``uses_odom``, else ``truth``."""
         ...
 
+    def place(self, points: np.ndarray, owner: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """:func:`~stage_sim.sim.collision.place` of body points (P, 2), point k with the pose of robot ``owner[k]``
+        (the rangers' origins at every sensing step)."""
+        ...
+
     def warm(self, robots: int) -> None:
         """Load what the first step would load (compiled kernels), for ``robots`` robots."""
         ...
@@ -85,6 +90,10 @@ class ReferenceMotion:
     def odometry(estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float,
                  uses_odom: np.ndarray, truth: np.ndarray) -> np.ndarray:
         return np.where(uses_odom[:, None], integrate_odometry(estimates, velocities, errors, dt), truth)
+
+    @staticmethod
+    def place(points: np.ndarray, owner: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        return place(points, poses[owner])
 
     @staticmethod
     def warm(robots: int) -> None:

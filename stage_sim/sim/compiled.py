@@ -96,6 +96,12 @@ class CompiledMotion:
         return out
 
     @staticmethod
+    def place(points: np.ndarray, owner: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        out = np.empty((len(points), 2))
+        motion_kernels.place_points(points, owner, poses, np.cos(poses[:, 2]), np.sin(poses[:, 2]), out)
+        return out
+
+    @staticmethod
     def warm(robots: int) -> None:
         motion_kernels.warm(robots)
 

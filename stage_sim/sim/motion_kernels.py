@@ -72,6 +72,17 @@ def integrate_estimates(estimates, velocities, errors, dt, cos_a, sin_a, uses_od
         out[i, 2] = normalize(estimates[i, 2] + da)
 
 
+@numba.njit(**_JIT)
+def place_points(points, owner, poses, cos_a, sin_a, out):
+    """:func:`~stage_sim.sim.collision.place` of ``points`` (P, 2) with the poses ``poses[owner]``, into ``out``;
+    ``cos_a``/``sin_a`` of ``poses[:, 2]``."""
+    for k in range(points.shape[0]):
+        i = owner[k]
+        px, py = points[k, 0], points[k, 1]
+        out[k, 0] = poses[i, 0] + cos_a[i] * px - sin_a[i] * py
+        out[k, 1] = poses[i, 1] + sin_a[i] * px + cos_a[i] * py
+
+
 def warm(robots: int) -> None:
     """Run every kernel once on arrays of the simulation's types, loading them from numba's cache."""
     n = max(robots, 1)
@@ -80,3 +91,4 @@ def warm(robots: int) -> None:
     every_drive = [DriveGroup(drive, rows) for drive in DRIVES.values()]
     body_velocities(values, every_drive, column, np.zeros((n, 8)), column, column, out)
     integrate_estimates(values, values, np.zeros((n, 4)), 0.1, column, column, flags, values, out)
+    place_points(values[:, :2].copy(), rows, values, column, column, np.empty((n, 2)))

@@ -22,7 +22,7 @@ from stage_sim.maps.raster import StaticRaster
 from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import RayCaster
 from stage_sim.sensing.robot_layer import RobotLayer
-from stage_sim.sim.collision import Bodies, GridFrame, place
+from stage_sim.sim.collision import Bodies, GridFrame
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
@@ -101,6 +101,10 @@ class RangerSensing:
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
+        self._longest_us = int(self._interval_us.max(initial=0))
+        self._all_due_us = 0
+        """From this sim time on every ranger is due (the common step, told without an array per ranger)."""
+        self._every_ray = np.ones(len(self._owner), dtype=bool)
         self._stale = True
 
     def reset(self, rng: np.random.Generator) -> None:
@@ -112,6 +116,7 @@ class RangerSensing:
         pending re-scan and random generator."""
         self.latest = previous.latest
         self._last_us = previous._last_us.copy()
+        self._all_due_us = previous._all_due_us
         self._stale = previous._stale
         self._rng = previous._rng
 
@@ -125,13 +130,19 @@ class RangerSensing:
         ``body_cells``: the robots' raster the rays see, (cell, robot)
         (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
-        due = ((now_us - self._last_us) >= self._interval_us) | self._stale
+        all_due = self._stale or now_us >= self._all_due_us
         self._stale = False
-        all_due = bool(due.all())
-        if not all_due and not due.any():
-            return
-        self._last_us[due] = now_us
-        ray_due = None if all_due else due[self._ranger_of_ray]
+        if all_due:
+            due = None
+            self._last_us[:] = now_us
+            self._all_due_us = now_us + self._longest_us
+        else:
+            due = (now_us - self._last_us) >= self._interval_us
+            if not due.any():
+                return
+            self._last_us[due] = now_us
+            self._all_due_us = int((self._last_us + self._interval_us).max())
+        ray_due = None if due is None else due[self._ranger_of_ray]
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
@@ -139,15 +150,15 @@ class RangerSensing:
         if self._bodies.count:
             robot_cells = self._raster(poses) if body_cells is None else body_cells
         jitter = self._angle_jitter(ray_due) if self._angle_noisy else None
-        origins = place(self._ranger_offset, poses[self._ranger_owner])
+        origins = self._backend.motion.place(self._ranger_offset, self._ranger_owner, poses)
         for group in self._groups:
             chosen = None if ray_due is None else np.flatnonzero(ray_due[group.rays])
             if chosen is None or chosen.size:
                 self._cast(group, chosen, poses, origins, jitter, robot_cells, ranges, intensity)
-        noisy = self._apply_noise(ranges, due[self._ranger_of_ray] if ray_due is None else ray_due) \
+        noisy = self._apply_noise(ranges, self._every_ray if ray_due is None else ray_due) \
             if self._noisy else ranges
         published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
-        for k in (range(len(due)) if all_due else np.flatnonzero(due)):
+        for k in (range(len(self._rangers)) if due is None else np.flatnonzero(due)):
             robot_index, ranger_index, part = self._scan_slots[k]
             scan = Scan(published[part], intensity[part], time)
             robot_scans = self.latest[robot_index]

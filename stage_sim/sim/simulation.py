@@ -17,13 +17,14 @@ Usage::
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from stage_sim.backend import resolve_kernels, resolve_threads
-from stage_sim.maps.raster import StaticRaster, build_static_raster
+from stage_sim.maps.raster import StaticRaster, build_static_raster, with_models
 from stage_sim.sim.backends import Backend, backend_for
 from stage_sim.sim.collision import Bodies, Contact, GridFrame
 from stage_sim.sim.drives import group_by_drive
@@ -31,7 +32,7 @@ from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kern
 from stage_sim.sim.odometry import draw_odom_errors, relative_pose
 from stage_sim.sim.rangers import RangerSensing, Scan
 from stage_sim.sim.robots import RobotSpec, build_robots
-from stage_sim.worldfile.description import WorldDescription, WorldWarning
+from stage_sim.worldfile.description import Model, WorldDescription, WorldWarning
 
 # Sim time is kept in integer microseconds, like Stage, so that no rounding drift accumulates.
 MICROSECONDS = 1_000_000
@@ -57,22 +58,13 @@ class Simulation:
         """``kernels``: "numba" or "numpy" (identical results; default numba, ``$STAGE_SIM_KERNELS``);
         ``threads``: kernel threads, 0 = all cores (identical results for any value; default 1,
         ``$STAGE_SIM_THREADS``). See :mod:`stage_sim.backend`."""
-        self.description = description
-        self.warnings: list[WorldWarning] = list(description.warnings)
-        self.robots: list[RobotSpec] = build_robots(description, self.warnings)
-        # Nobody chose: step on numpy until numba is loaded in the background (sim/kernel_upgrade.py).
-        beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
-        self._upgrade = KernelUpgrade(self) if upgrade_wanted(kernels, beams) else None
-        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(kernels)
+        self._kernels_asked = kernels
         self.threads = resolve_threads(threads)
         self.interval_us = max(1, round(description.settings.interval_sim * MICROSECONDS))
         self.watchdog_timeout = watchdog_timeout
-        starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
-        self.static: StaticRaster = build_static_raster(description, starts)
+        self._world_warnings: list[WorldWarning] = list(description.warnings)
+        self.robots: list[RobotSpec] = build_robots(description, self._world_warnings)
         self._bodies = Bodies.from_polygons([list(r.body) for r in self.robots])
-        self._collision, self._sensing = self.build_parts(self.kernels)
-        self._motion = backend_for(self.kernels).motion
-        note_kernels_running(self.kernels)
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
         self._drives = group_by_drive([r.settings.drive for r in self.robots])
@@ -81,12 +73,60 @@ class Simulation:
         self._uses_odom = np.array([r.settings.localization == "odom" for r in self.robots], dtype=bool)
         self._odom_origin = np.array(
             [self._odometry_origin(r) for r in self.robots], dtype=np.float64).reshape(n, 3)
+        starts = [(r.start[0], r.start[1], r.radius + description.settings.resolution) for r in self.robots]
+        self._furnish(description, build_static_raster(description, starts))
+        self.reset(seed)
+
+    def with_static_models(self, description: WorldDescription, seed: int | None = None) -> Simulation:
+        """A simulation of ``description``, this world with static models added (an episode's obstacles): what
+        ``Simulation(description, seed)`` with this one's watchdog, kernels and threads gives.
+
+        Built from this simulation's robots and raster, only the new bodies traced, when ``description`` keeps
+        this world's top-level models (the very objects, in order), adds no robot, puts the new static models
+        after this world's and they fit on its grid (an environment's reset builds one world per episode);
+        else built from scratch."""
+        added = self._added_static(description)
+        static = None if added is None else with_models(self.static, added)
+        if static is None:
+            return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
+        sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
+        sim._furnish(description, static)
+        sim.reset(seed)
+        return sim
+
+    def _added_static(self, description: WorldDescription) -> list[Model] | None:
+        """The top-level models ``description`` adds to this world, or None when it is not this world with static
+        models appended (see :meth:`with_static_models`)."""
+        own = self.description.models
+        ids = {id(model) for model in own}
+        kept = [model for model in description.models if id(model) in ids]
+        added = [(k, model) for k, model in enumerate(description.models) if id(model) not in ids]
+        last_static = max((k for k, model in enumerate(description.models)
+                           if id(model) in ids and model.type != "position"), default=-1)
+        if (len(kept) != len(own) or any(a is not b for a, b in zip(kept, own, strict=True))
+                or any(k < last_static for k, _ in added)
+                or any(part.type == "position" for _, model in added for part in model.walk())):
+            return None
+        return [model for _, model in added]
+
+    def _furnish(self, description: WorldDescription, static: StaticRaster) -> None:
+        """Everything that depends on the static world: its raster, the kernels (on numpy until numba is
+        loaded in the background when nobody chose, sim/kernel_upgrade.py), the contact checker, the ranger
+        sensing, and the warnings about robots that start inside an obstacle."""
+        self.description = description
+        self.static = static
+        beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
+        self._upgrade = KernelUpgrade(self) if upgrade_wanted(self._kernels_asked, beams) else None
+        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(self._kernels_asked)
+        self._collision, self._sensing = self.build_parts(self.kernels)
+        self._motion = backend_for(self.kernels).motion
+        note_kernels_running(self.kernels)
+        self.warnings = list(self._world_warnings)
         for index in np.flatnonzero(self._collision.overlapping(self._start)):
             robot = self.robots[index]
             self.warnings.append(WorldWarning(
                 f"robot '{robot.name}' starts overlapping an obstacle or another robot: it will stall until "
                 "it moves clear", robot.model.location))
-        self.reset(seed)
 
     @classmethod
     def from_world(
@@ -169,7 +209,7 @@ class Simulation:
             silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
-        moving = np.any(self.velocities != 0.0, axis=1)
+        moving = (self.velocities != 0.0).any(axis=1)
         layer = self._updates % 2
         moved, refused, layer_poses = self._collision.resolve(
             self.true_poses, self._layer_poses[layer], self.velocities, dt, moving)

@@ -70,7 +70,8 @@ BODY_TYPES = frozenset({"model", ROBOT_TYPE})
 BUILTIN_TYPES = MODEL_TYPES | {"window", "block", "sensor", *SENSOR_OF_WORLD_TYPE}
 MAX_MODELS = 100_000
 MAX_DEPTH = 100
-_UNIT_SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+UNIT_SQUARE = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+"""Stage's default body (scaled to the model's size): the one block of a model given neither blocks nor a bitmap."""
 
 
 def load_world(path: str | Path, reader: Reader = read_text_file) -> WorldDescription:
@@ -231,7 +232,7 @@ class _Loader:
         if kind == ROBOT_TYPE:
             model.position = position_settings(props)
         if kind in BODY_TYPES and not model.blocks and model.bitmap is None:
-            model.blocks.append(Block(_UNIT_SQUARE.copy(), (0.0, 1.0), None))
+            model.blocks.append(Block(UNIT_SQUARE.copy(), (0.0, 1.0), None))
         if kind in NOT_SIMULATED:
             self.not_simulated.setdefault(kind, []).append(instance.location)
         else:

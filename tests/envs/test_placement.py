@@ -4,6 +4,7 @@ for a scenario that can hold its robots (one that cannot is refused when the env
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -13,8 +14,10 @@ from stage_sim.envs import RobotBody
 from stage_sim.envs.free_space import FreeSpace, PlacementError
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
+from stage_sim.envs.worlds import arena_text, obstacle_models
 from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.loader import load_world_text
 
 SEEDS = 1000
 SMALL = RobotBody(laser_samples=16)
@@ -75,14 +78,17 @@ def test_a_thousand_resets_with_fresh_obstacles() -> None:
         check(sim, [0], starts, goals)
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
 @pytest.mark.parametrize("margin", [0.0, 0.1])
-def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obstacles(margin: float) -> None:
-    # What with_world saves (a distance transform of the whole world per episode) must change no answer.
+def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obstacles(margin: float,
+                                                                                      kernels: str) -> None:
+    # What with_world saves (a distance transform of the whole world per episode) must change no answer, with
+    # scipy's transforms and labels (numpy) or their compiled twins (numba).
     scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=12, body=SMALL))
-    base = Simulation(scenario.base, kernels="numba")
+    base = Simulation(scenario.base, kernels=kernels)
     root = FreeSpace(base, [0], margin)
     for seed in range(100):
-        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels="numba")
+        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels=kernels)
         derived, fresh = root.with_world(sim), FreeSpace(sim, [0], margin)
         assert derived.cells.size < root.cells.size
         np.testing.assert_array_equal(derived.regions, fresh.regions)
@@ -105,3 +111,36 @@ def test_a_scenario_that_cannot_hold_its_robots_is_refused_when_made() -> None:
     options = ScenarioOptions(scenario="random", n_robots=60, arena_size=4.0, body=SMALL)
     with pytest.raises(PlacementError, match="'random' scenario cannot hold 60 robot"):
         NavigationTask(Scenario(options), TaskConfig())
+
+
+@pytest.mark.parametrize("units", ["", 'unit_length "cm"\nunit_angle "radians"\n'])
+def test_obstacle_models_are_the_models_the_loader_makes_of_their_text(units: str) -> None:
+    boxes = np.column_stack([np.random.default_rng(3).uniform(-14, 14, (40, 2)),
+                             np.random.default_rng(4).uniform(0.3, 1.0, (40, 2)),
+                             np.random.default_rng(5).uniform(-math.pi, math.pi, 40)])
+    text = "".join(
+        f'model( name "obstacle_{i}" size [{w:.4f} {d:.4f} 1] pose [{x:.4f} {y:.4f} 0 {math.degrees(a):.4f}] '
+        'color "DarkSlateGray" obstacle_return 1 )\n' for i, (x, y, w, d, a) in enumerate(boxes))
+    parsed = load_world_text(units + arena_text(30.0) + text, "arena.world")
+    made = obstacle_models(boxes, parsed.settings)
+    assert len(made) == len(boxes)
+    for mine, theirs in zip(made, parsed.models[4:], strict=True):
+        theirs.location = None
+        theirs.blocks = [dataclasses.replace(b, location=None) for b in theirs.blocks]
+        assert [b.points.tolist() for b in mine.blocks] == [b.points.tolist() for b in theirs.blocks]
+        mine.blocks, theirs.blocks = [], []
+        assert mine == theirs
+
+
+@pytest.mark.parametrize("options", [
+    ScenarioOptions(world="rooms.world", body=SMALL),
+    ScenarioOptions(scenario="obstacles", n_obstacles=12, arena_size=6.0, body=SMALL),
+], ids=["rooms", "obstacles"])
+def test_the_compiled_free_space_is_scipys(options: ScenarioOptions) -> None:
+    scenario = Scenario(options)
+    bases = {kernels: Simulation(scenario.base, kernels=kernels) for kernels in ("numpy", "numba")}
+    for seed in range(5):
+        world = scenario.world(np.random.default_rng(seed), bases["numpy"])
+        spaces = [FreeSpace(Simulation(world, kernels=kernels), [0], 0.1) for kernels in ("numpy", "numba")]
+        np.testing.assert_array_equal(spaces[0].regions, spaces[1].regions)
+        np.testing.assert_array_equal(spaces[0].cells, spaces[1].cells)

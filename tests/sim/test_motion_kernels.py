@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from stage_sim.sim import motion_kernels
+from stage_sim.sim.collision import place
 from stage_sim.sim.drives import DRIVES, group_by_drive
 from stage_sim.sim.kinematics import body_velocity, integrate, normalize_angle
 from stage_sim.sim.odometry import integrate_odometry
@@ -69,3 +70,15 @@ def test_odometry_matches_the_reference(seed):
                                        uses_odom, truth, out)
     reference = np.where(uses_odom[:, None], integrate_odometry(estimates, velocities, errors, 0.1), truth)
     assert out.tobytes() == reference.tobytes()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_placed_points_match_the_reference(seed):
+    rng = np.random.default_rng(seed)
+    poses = np.stack([rng.uniform(-50, 50, N), rng.uniform(-50, 50, N), headings(rng)], axis=1)
+    points = rng.uniform(-1, 1, (N, 2))
+    points[rng.random(N) < 0.2] = 0.0
+    owner = rng.integers(0, N, N)
+    out = np.empty((N, 2))
+    motion_kernels.place_points(points, owner, poses, np.cos(poses[:, 2]), np.sin(poses[:, 2]), out)
+    assert out.tobytes() == place(points, poses[owner]).tobytes()

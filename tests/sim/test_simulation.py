@@ -295,3 +295,41 @@ def test_resets_cast_no_rays_and_the_next_step_scans_from_the_start_pose() -> No
     sim.step()
     assert sim.scans[0][0].stamp == pytest.approx(sim.sim_time)
     assert sim.scans[0][0].ranges[90] == pytest.approx(7.88)
+
+
+def test_a_world_with_static_models_added_simulates_as_if_built_from_scratch() -> None:
+    # An episode's obstacles: the simulation reuses its robots and raster and traces only the new bodies.
+    robots = 'bot( pose [2 5 0 0] ) bot( pose [6 6 0 90] )'
+    base = world(robots)
+    boxes = load_world_text(ROOM.format(drive="diff", extra="") + robots
+                            + 'model( name "box" size [0.5 0.3 1] pose [4 5.2 0 30] )'
+                            + 'model( name "low" size [0.4 0.4 0.05] pose [7 4 0 0] )', "test.world")
+    extended = WorldDescription(base.path, base.settings, [*base.models, *boxes.models[-2:]])
+    original = Simulation(base, seed=1)
+    built, fresh = original.with_static_models(extended, seed=4), Simulation(extended, seed=4)
+    assert built.robots is original.robots and built.static.bodies[0] is original.static.bodies[0]  # reused
+    assert built.static.shape == fresh.static.shape and built.static.origin_xy == fresh.static.origin_xy
+    assert [b.name for b in built.static.bodies] == [b.name for b in fresh.static.bodies]
+    for mine, theirs in zip(built.static.bodies, fresh.static.bodies, strict=True):
+        assert np.array_equal(mine.outline, theirs.outline) and mine.z == theirs.z
+    for sim in (built, fresh):
+        for k in range(25):
+            sim.set_velocity(0, 0.6, 0.0, 0.3 * math.sin(k / 4))
+            sim.set_velocity(1, 0.4, 0.0, -0.2)
+            sim.step()
+    assert np.array_equal(built.true_poses, fresh.true_poses) and np.array_equal(built.stalled, fresh.stalled)
+    assert all(np.array_equal(a[0].ranges, b[0].ranges) and np.array_equal(a[0].intensities, b[0].intensities)
+               for a, b in zip(built.scans, fresh.scans, strict=True))
+    assert built.description is extended and built.warnings == fresh.warnings
+
+
+def test_a_world_that_is_not_this_one_plus_static_models_is_built_from_scratch() -> None:
+    sim = sim_of('bot( pose [2 5 0 0] )')
+    far = load_world_text(ROOM.format(drive="diff", extra="") + 'model( size [1 1 1] pose [30 30 0 0] )', "f.world")
+    grown = WorldDescription(sim.description.path, sim.description.settings, [*sim.description.models, far.models[-1]])
+    other = world('bot( pose [3 5 0 0] )')
+    for description in (grown, other):  # the grid grows; other objects (a robot elsewhere)
+        made = sim.with_static_models(description, seed=0)
+        assert made.static.shape == Simulation(description, seed=0).static.shape
+        assert made.true_poses.tolist() == Simulation(description, seed=0).true_poses.tolist()
+    assert sim.with_static_models(grown).static.shape != sim.static.shape

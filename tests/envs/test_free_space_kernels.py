@@ -1,0 +1,57 @@
+"""The compiled region labelling numbers the regions exactly as scipy.ndimage.label does."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from stage_sim.envs.free_space_kernels import clear_near, label8
+
+EIGHT = np.ones((3, 3), dtype=bool)
+
+
+@pytest.mark.parametrize("density", [0.2, 0.45, 0.6, 0.9])
+def test_random_grids_get_scipys_labels(density: float) -> None:
+    rng = np.random.default_rng(int(density * 100))
+    for _ in range(40):
+        shape = tuple(rng.integers(1, 60, 2))
+        valid = rng.random(shape) < density
+        labels, count = label8(valid)
+        expected, expected_count = ndimage.label(valid, structure=EIGHT)
+        assert count == expected_count and labels.dtype == expected.dtype
+        np.testing.assert_array_equal(labels, expected)
+
+
+def test_spirals_and_diagonals_merge_late_as_in_scipy() -> None:
+    valid = np.zeros((40, 40), dtype=bool)
+    for k in range(0, 40, 4):  # combs joined at the bottom row: many provisional labels, one region
+        valid[:, k] = True
+    valid[-1, :] = True
+    np.fill_diagonal(valid[:20, 20:], True)  # a diagonal touching the combs only at corners
+    valid[5, 30:] = True
+    for grid in (valid, valid[::-1], valid[:, ::-1], ~valid, np.zeros((3, 4), bool), np.ones((1, 1), bool)):
+        labels, count = label8(grid)
+        expected, expected_count = ndimage.label(grid, structure=EIGHT)
+        assert count == expected_count
+        np.testing.assert_array_equal(labels, expected)
+
+
+@pytest.mark.parametrize("reach", [0.05, 0.349, 0.35, 0.6])
+def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float) -> None:
+    rng = np.random.default_rng(int(reach * 1000))
+    resolution = 0.05
+    pad = int(reach / resolution) + 1
+    rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
+    near = ~(np.sqrt((rows * rows + cols * cols).astype(np.float64)) * resolution > reach)
+    offsets = np.column_stack([rows[near], cols[near]]).astype(np.int64)
+    for _ in range(30):
+        added = np.zeros(tuple(rng.integers(5, 70, 2)), dtype=bool)
+        for _ in range(rng.integers(1, 4)):  # solid blocks (deep inner cells), some at the grid's edge
+            r, c = rng.integers(-5, added.shape[0]), rng.integers(-5, added.shape[1])
+            added[max(r, 0):r + rng.integers(1, 30), max(c, 0):c + rng.integers(1, 30)] = True
+        added |= rng.random(added.shape) < 0.01
+        valid = rng.random(added.shape) < 0.9
+        expected = valid & (ndimage.distance_transform_edt(~added) * resolution > reach)
+        clear_near(valid, added, np.flatnonzero(added), offsets)
+        np.testing.assert_array_equal(valid, expected)
