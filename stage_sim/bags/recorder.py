@@ -149,10 +149,11 @@ class BagRecorder:
         a full queue makes a lossless recording wait and a real-time one drop the batch."""
         if self.error is not None:
             return
+        now = time.monotonic()
         if not self._pending.count:
-            self._pending_since = time.monotonic()
+            self._pending_since = now
         self._pending.capture(self._sim, self._names, self._messages.stepped)
-        if self._pending.full or time.monotonic() - self._pending_since >= WAKE_S:
+        if self._pending.full or now - self._pending_since >= WAKE_S:
             self._hand_over(wait=self.lossless)
 
     def _hand_over(self, wait: bool) -> None:

@@ -11,7 +11,7 @@ second.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from stage_sim.bags.layouts import Layout
@@ -39,11 +39,12 @@ class StepMessages:
     """Turns :class:`StepState` into (bag topic, log time ns, CDR bytes), as stageros publishes each step."""
 
     channels: list[StepChannel]
+    stepped: tuple[Topic, ...] = field(init=False)
+    """The topics whose values a :class:`~stage_sim.bags.step_state.StepBatch` copies, in this order (made
+    once: the stepping side reads it every step)."""
 
-    @property
-    def stepped(self) -> list[Topic]:
-        """The topics whose values a :class:`~stage_sim.bags.step_state.StepBatch` copies, in this order."""
-        return [channel.topic for channel in self.channels]
+    def __post_init__(self) -> None:
+        self.stepped = tuple(channel.topic for channel in self.channels)
 
     def step(self, state: StepState) -> Iterator[tuple[str, int, bytes]]:
         """Everything one step publishes on the recorded topics, in stageros' publishing order."""

@@ -95,9 +95,9 @@ class _Writer:
         """Write the batch's steps, unless an earlier write failed (then they are dropped: the recording has
         stopped)."""
         for state in batch.steps():
-            self.last_us = state.sim_time_us
             if self.error is not None:
                 return
+            self.last_us = state.sim_time_us
             try:
                 for message in self._messages.step(state):
                     self.write(*message)

@@ -8,10 +8,11 @@ once for all worlds as arrays instead of once per world; only the simulation ste
 
 Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
 next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
-neither terminated nor truncated. ``autoreset_mode=AutoresetMode.SAME_STEP`` (or ``"SameStep"``; what Stable-Baselines3 and other libraries
-that predate Gymnasium 1.0 expect) resets it within the step that ended it instead: that step returns the new
-episode's first observation, and the last one in ``infos["final_obs"]`` (with its infos in
-``infos["final_info"]``), as ``SyncVectorEnv(..., autoreset_mode=AutoresetMode.SAME_STEP)`` does.
+neither terminated nor truncated. ``autoreset_mode=AutoresetMode.SAME_STEP`` (or ``"SameStep"``: what
+Stable-Baselines3 and other libraries that predate Gymnasium 1.0 expect) resets it within the step that ended
+it instead: that step returns the new episode's first observation, and the last one in ``infos["final_obs"]``
+(with its infos in ``infos["final_info"]``), as ``SyncVectorEnv(..., autoreset_mode=AutoresetMode.SAME_STEP)``
+does.
 """
 
 from __future__ import annotations
