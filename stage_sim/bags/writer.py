@@ -20,6 +20,7 @@ recording in order.
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import traceback
 from dataclasses import dataclass, field
@@ -104,7 +105,7 @@ class _Writer:
             except OSError as exc:
                 self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
                 self.bag.abort()
-                self._reports.send(Failed(self.error))
+                _report(self._reports, Failed(self.error))
 
 
 def main(argv: list[str]) -> None:
@@ -114,9 +115,15 @@ def main(argv: list[str]) -> None:
     steps, reports = Connection(int(argv[0]), writable=False), Connection(int(argv[1]), readable=False)
     try:
         plan = steps.recv()
-    except EOFError:  # the simulation ended before it sent the plan
+    except (EOFError, OSError):  # the simulation ended before it sent the plan
         return
     write_bag(plan, steps, reports)
+
+
+def _report(reports: Connection, report: Opened | Failed | Closed) -> None:
+    """Tell the simulation, if it is still there to hear (after a kill -9 the bag is finished all the same)."""
+    with contextlib.suppress(BrokenPipeError):
+        reports.send(report)
 
 
 def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
@@ -124,7 +131,7 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
     try:
         bag = McapBag(plan.path, plan.topics, plan.speedup)
     except BagError as exc:
-        reports.send(Opened(str(exc)))
+        _report(reports, Opened(str(exc)))
         return
     writer = _Writer(bag, plan.messages, reports)
     try:
@@ -134,19 +141,19 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
             bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             bag.abort()
-            reports.send(Opened(f"cannot write bag {plan.path}: {exc.strerror or exc}"))
+            _report(reports, Opened(f"cannot write bag {plan.path}: {exc.strerror or exc}"))
             return
-        reports.send(Opened(None))
+        _report(reports, Opened(None))
         metadata = _write_steps(writer, steps)
         if writer.error is None:
             try:
                 bag.finish(metadata)
             except OSError as exc:
-                reports.send(Failed(exc.strerror or str(exc)))
-        reports.send(Closed(writer.count))
+                _report(reports, Failed(exc.strerror or str(exc)))
+        _report(reports, Closed(writer.count))
     except BaseException:  # a bug: the stepping side raises it with this traceback
         bag.abort()
-        reports.send(Closed(writer.count, traceback.format_exc()))
+        _report(reports, Closed(writer.count, traceback.format_exc()))
 
 
 def _write_steps(writer: _Writer, steps: Connection) -> dict[str, str]:
@@ -154,7 +161,7 @@ def _write_steps(writer: _Writer, steps: Connection) -> dict[str, str]:
     while True:
         try:
             item = steps.recv()
-        except EOFError:
+        except (EOFError, OSError):  # OSError: the sender was killed in the middle of a batch
             stopped = "its start" if writer.last_us is None else f"sim time {writer.last_us / 1e6:g} s"
             return {"interrupted": f"the simulation ended without closing the bag after {stopped}"}
         if isinstance(item, Finish):
