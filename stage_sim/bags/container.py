@@ -175,9 +175,12 @@ class McapBag:
             raise self._file.error
         return result
 
-    def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
-        """Add one message (log and publish time = its sim stamp); raises OSError when the disk refuses."""
-        self._log[topic](data, log_time_ns)
+    def write(self, log_time_ns: int, messages: list[tuple[str, bytes]]) -> None:
+        """Add messages (topic, CDR bytes) of one time (log and publish time = their sim stamp): a step's;
+        raises OSError when the disk refuses."""
+        log = self._log
+        for topic, data in messages:
+            log[topic](data, log_time_ns)
         self._file.commit()
         if self._file.error is not None:  # the library only logs a failed write of a chunk
             raise self._file.error

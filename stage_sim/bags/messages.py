@@ -202,8 +202,9 @@ class MessageBuilder:
                 self._latched.append((topic, [(name, TOPIC_MESSAGES[topic].build(e, sim, names), e)
                                               for name, e in endpoints]))
             else:
-                outlets = [(name, LAYOUTS[topic](template(topic, e, sim, names)), e) for name, e in endpoints]
-                channels.append(StepChannel(topic, outlets, LAYOUTS[topic].prepare))
+                chosen = [e for _, e in endpoints]
+                layout = LAYOUTS[topic]([template(topic, e, sim, names) for e in chosen], chosen)
+                channels.append(StepChannel(topic, [name for name, _ in endpoints], layout))
         self.stepping = StepMessages(channels)
         """The per-step messages: which topics a :class:`~stage_sim.bags.step_state.StepBatch` copies and how
         the writer refills them."""

@@ -10,28 +10,21 @@ second.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
 
 from stage_sim.bags.layouts import Layout
 from stage_sim.bags.step_state import StepState
-from stage_sim.interface import fields
-from stage_sim.interface.topics import Endpoint, Timing, Topic
-
-if TYPE_CHECKING:
-    pass
+from stage_sim.interface.topics import Topic
 
 
 @dataclass
 class StepChannel:
-    """One per-step interface topic in the bag and, per recorded endpoint, its bag topic, its layout (the
-    template bytes it refills) and its endpoint."""
+    """One per-step interface topic in the bag: the bag topic of each recorded endpoint, in the order of the
+    layout's endpoints, and the layout that refills all their messages."""
 
     topic: Topic
-    outlets: list[tuple[str, Layout, Endpoint]]
-    prepare: Callable[[Any], Any]
-    """The layouts' :meth:`Layout.prepare`, run once per step for all of the topic's endpoints."""
+    names: list[str]
+    layout: Layout
 
 
 @dataclass
@@ -46,23 +39,16 @@ class StepMessages:
     def __post_init__(self) -> None:
         self.stepped = tuple(channel.topic for channel in self.channels)
 
-    def step(self, state: StepState) -> Iterator[tuple[str, int, bytes]]:
-        """Everything one step publishes on the recorded topics, in stageros' publishing order."""
+    def step(self, state: StepState) -> list[tuple[str, bytes]]:
+        """Everything one step publishes on the recorded topics (bag topic, CDR bytes), in stageros'
+        publishing order; their log time is the step's stamp."""
         sim_time_us = state.sim_time_us
-        log_time = fields.stamp_ns(sim_time_us)
+        messages = []
         for channel, values in zip(self.channels, state.values, strict=True):
-            values = channel.prepare(values)
-            for name, layout, endpoint in channel.outlets:
-                data = layout.refill(values, endpoint, sim_time_us)
-                if data is not None:
-                    yield name, log_time, data
+            refilled = channel.layout.refill(values, sim_time_us)
+            messages += [(name, data) for name, data in zip(channel.names, refilled, strict=True) if data is not None]
+        return messages
 
     def publications(self, state: StepState) -> int:
         """How many messages :meth:`step` makes of ``state`` (without building them)."""
-        count = 0
-        for channel, values in zip(self.channels, state.values, strict=True):
-            if channel.topic.timing is Timing.STEP:
-                count += len(channel.outlets)
-            else:
-                count += sum(values.measured(e.robot, e.ranger) is not None for _, _, e in channel.outlets)
-        return count
+        return sum(channel.layout.count(values) for channel, values in zip(self.channels, state.values, strict=True))

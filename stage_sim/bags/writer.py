@@ -32,6 +32,7 @@ from stage_sim.bags.errors import BagError
 from stage_sim.bags.step_messages import StepMessages
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import Topic
+from stage_sim.interface import fields
 
 
 @dataclass(frozen=True)
@@ -88,9 +89,9 @@ class _Writer:
         """The sim time of the last step written."""
         self.error: str | None = None
 
-    def write(self, topic: str, log_time: int, data: bytes) -> None:
-        self.bag.write(topic, log_time, data)
-        self.count += 1
+    def write(self, log_time: int, messages: list[tuple[str, bytes]]) -> None:
+        self.bag.write(log_time, messages)
+        self.count += len(messages)
 
     def steps(self, batch: StepBatch) -> None:
         """Write the batch's steps, unless an earlier write failed (then they are dropped: the recording has
@@ -100,8 +101,7 @@ class _Writer:
                 return
             self.last_us = state.sim_time_us
             try:
-                for message in self._messages.step(state):
-                    self.write(*message)
+                self.write(fields.stamp_ns(state.sim_time_us), self._messages.step(state))
             except OSError as exc:
                 self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
                 self.bag.abort()
@@ -136,8 +136,8 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
     writer = _Writer(bag, plan.messages, reports)
     try:
         try:
-            for message in plan.static:
-                writer.write(*message)
+            for topic, log_time, data in plan.static:
+                writer.write(log_time, [(topic, data)])
             bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             bag.abort()

@@ -23,13 +23,18 @@ def test_every_per_step_topic_has_a_layout() -> None:
     assert set(LAYOUTS) == set(STEPPED)
 
 
+@pytest.mark.parametrize("chosen", ["every endpoint", "the last endpoints first"])
 @pytest.mark.parametrize("topic", STEPPED, ids=lambda t: t.name)
-def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic) -> None:
+def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen) -> None:
+    """Also with the endpoints recorded in another order than the simulation's (a bag of chosen topics):
+    a topic's layout then gathers each one's values from where they are."""
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=5)
     names = names_of(sim)
     endpoints = topics.endpoints(topic, names)
+    if chosen != "every endpoint":
+        endpoints = endpoints[::-1]
     # as the writer process gets them: pickled (a layout travels as its template)
-    layouts = pickle.loads(pickle.dumps([LAYOUTS[topic](template(topic, e, sim, names)) for e in endpoints]))
+    layout = pickle.loads(pickle.dumps(LAYOUTS[topic]([template(topic, e, sim, names) for e in endpoints], endpoints)))
     messages = [TOPIC_MESSAGES[topic].build(e, sim, names) for e in endpoints]
     for robot, command in enumerate(COMMANDS):
         sim.set_velocity(robot, *command)
@@ -39,11 +44,11 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic) -> None:
         batch = StepBatch.first(sim, names, [topic], 1)
         batch.capture(sim, names, [topic])
         ((captured,),) = [state.values for state in pickle.loads(pickle.dumps(batch)).steps()]
-        prepared = LAYOUTS[topic].prepare(captured)
         values = topic.values(sim, names)
-        for endpoint, layout, msg in zip(endpoints, layouts, messages, strict=True):
+        refilled_all = layout.refill(captured, sim.sim_time_us)
+        assert layout.count(captured) == sum(data is not None for data in refilled_all)
+        for endpoint, refilled, msg in zip(endpoints, refilled_all, messages, strict=True):
             filled = TOPIC_MESSAGES[topic].fill(msg, values, endpoint, _time(sim.sim_time_us))
-            refilled = layout.refill(prepared, endpoint, sim.sim_time_us)
             if filled is None:
                 assert refilled is None
                 continue
