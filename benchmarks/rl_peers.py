@@ -7,6 +7,9 @@ The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-bea
 * ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
   obstacles scenario; episodes that end are reset (resets count in the time);
 * ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env);
+* ``stage_sim rays``: the floor under both, Stage's ray walk alone: the same core run, but the rate counts only
+  the seconds spent in the compiled ray walk (its calls timed one by one), so it says how fast any step that
+  casts these lidars the way Stage does could be on this core;
 * ``navground env`` / ``navground world``: navground 0.7 through navground-learning's Gymnasium env (1
   robot) or shared parallel env (10, 100), and its bare ``World`` (commands set, ``actuate``, every
   agent's lidar updated);
@@ -50,7 +53,7 @@ DT = 0.1
 V_MAX, W_MAX = 1.0, math.pi / 2
 #: Case → the venv (under --venvs) whose interpreter runs it; None: this interpreter (stage_sim's venv).
 CASES: dict[str, str | None] = {
-    "stage_sim env": None, "stage_sim core": None,
+    "stage_sim env": None, "stage_sim core": None, "stage_sim rays": None,
     "navground env": "navground", "navground world": "navground",
     "irsim-x": "irsim-x", "ir-sim": "ir-sim",
 }
@@ -104,6 +107,14 @@ class Runner:
     def step(self, action: np.ndarray) -> int:
         raise NotImplementedError
 
+    def start_timing(self) -> None:
+        """The warm-up is over: what :meth:`timed_seconds` counts starts now."""
+
+    def timed_seconds(self, wall: float) -> float:
+        """The seconds the rate counts of ``wall`` seconds of stepping: all of them, unless a runner times a
+        part."""
+        return wall
+
 
 class EnvRunner(Runner):
     """A Gymnasium env (one robot; reset when its episode ends) or a PettingZoo parallel env (reset when no
@@ -154,6 +165,33 @@ class StageCore(StageEnv):
         self.sim.commands[:, 2] = action[:, 1]
         self.sim.step()
         return len(action)
+
+
+class StageRays(StageCore):
+    """The core run with the compiled ray walk's calls timed: the rate of the rays alone."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        from stage_sim.sensing import traversal
+
+        super().__init__(robots, seed)
+        self.ray_seconds = 0.0
+        for name in ("cast_serial", "cast_parallel"):
+            setattr(traversal, name, self._timed(getattr(traversal, name)))
+
+    def _timed(self, kernel: Callable[..., Any]) -> Callable[..., Any]:
+        def timed(*args: Any) -> Any:
+            start = time.perf_counter()
+            try:
+                return kernel(*args)
+            finally:
+                self.ray_seconds += time.perf_counter() - start
+        return timed
+
+    def start_timing(self) -> None:
+        self.ray_seconds = 0.0
+
+    def timed_seconds(self, wall: float) -> float:
+        return self.ray_seconds
 
 
 def stage_sees_robots() -> bool:
@@ -297,7 +335,7 @@ def irsim_sees_robots() -> bool:
 
 
 RUNNERS: dict[str, type[Runner]] = {
-    "stage_sim env": StageEnv, "stage_sim core": StageCore, "navground env": NavgroundEnv,
+    "stage_sim env": StageEnv, "stage_sim core": StageCore, "stage_sim rays": StageRays, "navground env": NavgroundEnv,
     "navground world": NavgroundWorld, "irsim-x": IrSim, "ir-sim": IrSim,
 }
 
@@ -310,11 +348,13 @@ def measure(case: str, robots: int, seconds: float, seed: int) -> dict[str, Any]
     for action in commands[:WARM_UP]:
         runner.step(action)
     steps = live = 0
+    runner.start_timing()
     start = time.perf_counter()
     while (elapsed := time.perf_counter() - start) < seconds:
         live += runner.step(commands[steps % ACTION_ROWS])
         steps += 1
-    return {"steps": steps, "agent_steps_per_s": robots * steps / elapsed, "live_agent_steps_per_s": live / elapsed,
+    timed = runner.timed_seconds(elapsed)
+    return {"steps": steps, "agent_steps_per_s": robots * steps / timed, "live_agent_steps_per_s": live / timed,
             "lidar_sees_robots": runner.sees_robots}
 
 

@@ -32,7 +32,7 @@ from stage_sim.bags.errors import BagError
 from stage_sim.bags.messages import MessageBuilder
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import select, stageros_topics
-from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan
+from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan, send_batch
 from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
@@ -140,8 +140,10 @@ class BagRecorder:
 
     @property
     def failed(self) -> bool:
-        """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded)."""
-        self._read_reports()
+        """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded). Cheap
+        enough for every step: the sender thread reads the writer's reports, the stepping thread only these
+        flags (a system call here, once per step, let the sender take the interpreter lock in the middle of
+        the simulation's step)."""
         return self.error is not None or self._writer_lost or self._closed is not None
 
     def record_step(self) -> None:
@@ -207,14 +209,16 @@ class BagRecorder:
         return self.summary
 
     def _send(self) -> None:
-        """The sender thread: pipe each queued batch to the writer (pickling it here, off the stepping thread),
-        until the closing None; if the writer has gone, the batches are dropped (close says why)."""
+        """The sender thread: pipe each queued batch to the writer (pickling it here, off the stepping thread,
+        its arrays out of band), until the closing None; if the writer has gone, the batches are dropped (close
+        says why)."""
         while (batch := self._queue.get()) is not None:
             if not self._writer_lost:
                 try:
-                    self._steps.send(batch)
+                    send_batch(self._steps, batch)
                 except OSError:
                     self._writer_lost = True
+            self._read_reports()
 
     def _next_report(self, timeout: float | None) -> Opened | Failed | Closed | None:
         """The writer's next report, None if it ended (or ``timeout`` passed) without one."""
@@ -228,8 +232,8 @@ class BagRecorder:
             return None
 
     def _read_reports(self) -> None:
-        """Take the reports that have come, without waiting (once per batch: hence select, not
-        Connection.poll, which builds a selector per call)."""
+        """Take the reports that have come, without waiting (the sender thread, once per batch: hence select,
+        not Connection.poll, which builds a selector per call)."""
         while not self._reports.closed and ready([self._reports], [], [], 0)[0]:
             try:
                 self._take(self._reports.recv())

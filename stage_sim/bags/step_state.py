@@ -136,20 +136,17 @@ class _Scans(_Column):
         return _Scans(self.first, self.lengths, size)
 
     def put(self, k: int, value: fields.LatestScans) -> None:
-        scans = [scan for robot in value.scans for scan in robot]
-        measured = [scan.stamp == value.time for scan in scans]
-        if all(measured):  # the common case: every ranger measures every step
+        beams = value.beams
+        if beams is None or beams.time != value.time:  # no ranger measured in this step
+            self.measured[k] = False
+        elif beams.due is None:  # the common case: every ranger measured, the beams are the row
             self.measured[k] = True
-            taken, beams = scans, self.beams
+            self.ranges[k], self.intensities[k] = beams.ranges, beams.intensities
         else:
-            self.measured[k] = measured
-            taken = [scan for scan, took in zip(scans, measured, strict=True) if took]
-            beams = sum(len(scan.ranges) for scan in taken)
-        if len(taken) == 1:
-            self.ranges[k, :beams], self.intensities[k, :beams] = taken[0].ranges, taken[0].intensities
-        elif taken:
-            np.concatenate([scan.ranges for scan in taken], out=self.ranges[k, :beams])
-            np.concatenate([scan.intensities for scan in taken], out=self.intensities[k, :beams])
+            self.measured[k] = beams.due
+            taken = int(np.count_nonzero(beams.ray_due))
+            self.ranges[k, :taken], self.intensities[k, :taken] = beams.ranges[beams.ray_due], \
+                beams.intensities[beams.ray_due]
 
     def row(self, k: int) -> PackedScans:
         offsets, at = [], 0

@@ -8,19 +8,20 @@ process of its own it runs on another core, and the stepping side only copies ea
 The process is ``python -m stage_sim.bags STEPS REPORTS`` (:mod:`stage_sim.bags.__main__`): a fresh
 interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would re-run
 the user's main script. STEPS and REPORTS are its two pipes' file descriptors; what goes through them is
-pickled by :mod:`multiprocessing.connection`. It first reads a :class:`WriterPlan` from the steps pipe and
-answers on the reports pipe with :class:`Opened` once the file is created and the latched messages are on
-disk, :class:`Failed` when the disk refuses a write (it then reads and discards what comes, so the simulation
-is never blocked by a dead recording), and :class:`Closed` at the end. It reads lists of steps until
-:class:`Finish`, or until the pipe ends without one (the simulation was killed): it then still writes the
-summary, so a kill -9 of the simulator leaves a complete bag of every step it had sent. It ignores SIGINT and
-SIGTERM: Ctrl-C in a terminal reaches the whole process group, and the simulation's own handler closes the
-recording in order.
+pickled by :mod:`multiprocessing.connection`, a batch's arrays out of band (:class:`BatchFrame`). It first
+reads a :class:`WriterPlan` from the steps pipe and answers on the reports pipe with :class:`Opened` once the
+file is created and the latched messages are on disk, :class:`Failed` when the disk refuses a write (it then
+reads and discards what comes, so the simulation is never blocked by a dead recording), and :class:`Closed` at
+the end. It reads lists of steps until :class:`Finish`, or until the pipe ends without one (the simulation was
+killed): it then still writes the summary, so a kill -9 of the simulator leaves a complete bag of every step
+it had sent. It ignores SIGINT and SIGTERM: Ctrl-C in a terminal reaches the whole process group, and the
+simulation's own handler closes the recording in order.
 """
 
 from __future__ import annotations
 
 import contextlib
+import pickle
 import signal
 import traceback
 from dataclasses import dataclass, field
@@ -46,6 +47,41 @@ class WriterPlan:
     static: list[tuple[str, int, bytes]]
     """The latched messages, serialised (/tf_static, /map)."""
     messages: StepMessages
+
+
+@dataclass(frozen=True)
+class BatchFrame:
+    """A :class:`StepBatch` as it goes down the pipe: its pickle (protocol 5) without its arrays, which follow
+    as ``buffers`` byte messages of their own. PEP 574's out-of-band buffers: neither side copies the arrays
+    (a 100-robot step holds 200 kB of beams) into or out of a pickle."""
+
+    pickle: bytes
+    buffers: int
+
+
+IN_BAND_BYTES = 4096
+"""Arrays smaller than this travel inside the pickle (a message of their own would cost more)."""
+
+
+def send_batch(steps: Connection, batch: StepBatch) -> None:
+    """Send ``batch`` as a :class:`BatchFrame` and its arrays (raises OSError when the writer is gone)."""
+    buffers: list[pickle.PickleBuffer] = []
+
+    def out_of_band(buffer: pickle.PickleBuffer) -> bool:
+        if buffer.raw().nbytes < IN_BAND_BYTES:
+            return True
+        buffers.append(buffer)
+        return False
+
+    frame = BatchFrame(pickle.dumps(batch, protocol=5, buffer_callback=out_of_band), len(buffers))
+    steps.send(frame)
+    for buffer in buffers:
+        steps.send_bytes(buffer.raw())
+
+
+def _receive_batch(steps: Connection, frame: BatchFrame) -> StepBatch:
+    """The batch ``frame`` starts (its arrays are read-only views of the bytes received)."""
+    return pickle.loads(frame.pickle, buffers=[steps.recv_bytes() for _ in range(frame.buffers)])
 
 
 @dataclass(frozen=True)
@@ -161,6 +197,8 @@ def _write_steps(writer: _Writer, steps: Connection) -> dict[str, str]:
     while True:
         try:
             item = steps.recv()
+            if isinstance(item, BatchFrame):
+                item = _receive_batch(steps, item)
         except (EOFError, OSError):  # OSError: the sender was killed in the middle of a batch
             stopped = "its start" if writer.last_us is None else f"sim time {writer.last_us / 1e6:g} s"
             return {"interrupted": f"the simulation ended without closing the bag after {stopped}"}

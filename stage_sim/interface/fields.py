@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from stage_sim.sim.rangers import Scan
+    from stage_sim.sim.rangers import MeasuredBeams, Scan
     from stage_sim.sim.robots import RangerSpec
     from stage_sim.sim.simulation import Simulation
 
@@ -75,6 +75,8 @@ class LatestScans:
 
     scans: list[list[Scan]]
     time: float
+    beams: MeasuredBeams | None = None
+    """The beams the scans are views of, every ranger's end to end (:attr:`Simulation.measured_beams`)."""
 
     def measured(self, robot: int, ranger: int) -> Scan | None:
         """The scan ranger ``ranger`` of robot ``robot`` took in this step, None if it took none."""
@@ -84,9 +86,9 @@ class LatestScans:
     def snapshot(self) -> LatestScans:
         """The same step's measurements, safe to keep after the simulation steps on (scans are never changed,
         only replaced: copying the lists is enough)."""
-        return LatestScans([list(robot) for robot in self.scans], self.time)
+        return LatestScans([list(robot) for robot in self.scans], self.time, self.beams)
 
 
 def latest_scans(sim: Simulation) -> LatestScans:
     """The scans of the step just taken."""
-    return LatestScans(sim.scans, sim.sim_time)
+    return LatestScans(sim.scans, sim.sim_time, sim.measured_beams)

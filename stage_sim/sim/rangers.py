@@ -39,6 +39,22 @@ class Scan:
 
 
 @dataclass(frozen=True)
+class MeasuredBeams:
+    """Every beam the last sensing cast, all rangers' end to end in robot and ranger order (the scans are views
+    of these): a recording copies a step's scans in one piece."""
+
+    time: float
+    """The sim time of that sensing (s): the scans' stamp."""
+    ranges: np.ndarray
+    """float32, a value per beam of every ranger; those of rangers not due hold nothing."""
+    intensities: np.ndarray
+    due: np.ndarray | None
+    """Which rangers measured (bool per ranger), None: all of them."""
+    ray_due: np.ndarray | None
+    """The same per beam."""
+
+
+@dataclass(frozen=True)
 class _HeightGroup:
     """The rays cast at one height, with the static layer and the robots visible there."""
 
@@ -99,6 +115,8 @@ class RangerSensing:
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
         self.latest: list[list[Scan]] = [[] for _ in robots]
+        self.measured: MeasuredBeams | None = None
+        """The beams of the last sensing that cast any (None before the first)."""
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
         self._longest_us = int(self._interval_us.max(initial=0))
@@ -115,6 +133,7 @@ class RangerSensing:
         """Carry on where ``previous`` (the same rangers on other kernels) stands: its latest scans, schedule,
         pending re-scan and random generator."""
         self.latest = previous.latest
+        self.measured = previous.measured
         self._last_us = previous._last_us.copy()
         self._all_due_us = previous._all_due_us
         self._stale = previous._stale
@@ -158,6 +177,7 @@ class RangerSensing:
         noisy = self._apply_noise(ranges, self._every_ray if ray_due is None else ray_due) \
             if self._noisy else ranges
         published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
+        self.measured = MeasuredBeams(time, published, intensity, due, ray_due)
         for k in (range(len(self._rangers)) if due is None else np.flatnonzero(due)):
             robot_index, ranger_index, part = self._scan_slots[k]
             scan = Scan(published[part], intensity[part], time)

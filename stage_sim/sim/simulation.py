@@ -30,7 +30,7 @@ from stage_sim.sim.collision import Bodies, Contact, GridFrame
 from stage_sim.sim.drives import group_by_drive
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kernels_running, upgrade_wanted
 from stage_sim.sim.odometry import draw_odom_errors, relative_pose
-from stage_sim.sim.rangers import RangerSensing, Scan
+from stage_sim.sim.rangers import MeasuredBeams, RangerSensing, Scan
 from stage_sim.sim.robots import RobotSpec, build_robots
 from stage_sim.worldfile.description import Model, WorldDescription, WorldWarning
 
@@ -275,6 +275,12 @@ class Simulation:
     def scans(self) -> list[list[Scan]]:
         """Latest scan of every ranger, per robot (``scans[robot][ranger]``)."""
         return self._sensing.latest
+
+    @property
+    def measured_beams(self) -> MeasuredBeams | None:
+        """The beams of the last step that cast any, every ranger's end to end (:attr:`scans` are views of
+        them); None before the first."""
+        return self._sensing.measured
 
     def state(self, robot: int) -> RobotState:
         """One robot's true pose, odometry, applied velocity and stall flag."""

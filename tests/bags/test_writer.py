@@ -1,5 +1,5 @@
-"""The writer process's body, fed by hand: a simulator killed in the middle of sending a batch still leaves a
-complete bag of every whole batch it sent."""
+"""The writer process's body, fed by hand: a simulator killed in the middle of sending a batch (its frame or
+its arrays) still leaves a complete bag of every whole batch it sent."""
 
 from __future__ import annotations
 
@@ -8,10 +8,12 @@ import struct
 import threading
 from multiprocessing.connection import Connection
 
+import pytest
+
 from stage_sim.bags.messages import MessageBuilder
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import stageros_topics
-from stage_sim.bags.writer import Closed, Opened, WriterPlan, write_bag
+from stage_sim.bags.writer import BatchFrame, Closed, Opened, WriterPlan, send_batch, write_bag
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world
 from tests.bags.readers import READERS
@@ -19,7 +21,8 @@ from tests.bags.test_recorder import names_of
 from tests.bags.worlds import two_robot_world
 
 
-def test_a_batch_cut_short_ends_the_input_and_the_bag_is_still_finished(tmp_path) -> None:
+@pytest.mark.parametrize("cut", ["in its frame", "in its arrays"])
+def test_a_batch_cut_short_ends_the_input_and_the_bag_is_still_finished(tmp_path, cut) -> None:
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
     names = names_of(sim)
     topics = stageros_topics(names, False)
@@ -37,8 +40,10 @@ def test_a_batch_cut_short_ends_the_input_and_the_bag_is_still_finished(tmp_path
     for _ in range(5):
         sim.step()
         batch.capture(sim, names, builder.stepping.stepped)
-    steps.send(batch)
-    os.write(steps.fileno(), struct.pack("!i", 1000) + b"\x80\x05 half a batch")  # killed while sending the next
+    send_batch(steps, batch)
+    if cut == "in its arrays":
+        steps.send(BatchFrame(b"the next batch, without its arrays", 3))
+    os.write(steps.fileno(), struct.pack("!i", 1000) + b"\x80\x05 half a message")  # killed while sending it
     steps.close()
     writer.join(timeout=30)
     assert reports.recv() == Closed(1 + 5 * 12)
