@@ -4,9 +4,10 @@ A message stageros publishes every step changes in a few fields only (the stamp,
 strings (frame ids) and sizes (beams, robots) are fixed for the run. So each endpoint's message is serialised
 once by rosbags (the template: :mod:`stage_sim.bags.messages` builds it), and every step writes only the
 changing fields into those bytes, at offsets read off the template: no message objects and no serialiser per
-message. All endpoints of a topic (100 robots' odometry, their scans) share one buffer (:class:`_Block`), laid
-out so that each field of every message is refilled by one numpy assignment per step, not a Python call per
-message: with 100 robots the writer process's own Python per message was most of its CPU.
+message. All endpoints of a topic (100 robots' odometry, their scans), for every step of a batch, share one
+buffer (:class:`_Block`), laid out so that a field of every message of the batch is refilled by one numpy
+assignment, not a Python call per message and step: the writer process's own Python per message and step
+was most of its CPU, with 1 robot as with 100.
 tests/bags/test_layouts.py holds the refilled bytes to rosbags' serialisation of the same values, byte for byte.
 
 CDR (little endian, as rosbags writes on this machine): a 4-byte encapsulation header, then each field at an
@@ -28,7 +29,7 @@ from stage_sim.interface import fields
 from stage_sim.interface.topics import Endpoint
 
 if TYPE_CHECKING:
-    from stage_sim.bags.step_state import PackedScans
+    from stage_sim.bags.step_state import PackedScans, ScanRows
 
 HEADER = 4
 """Bytes of the CDR encapsulation header: alignment counts from here."""
@@ -56,28 +57,35 @@ def _after_header(data: bytes, offset: int) -> int:
     return _after_string(data, _aligned(offset, 4) + _STAMP.size)
 
 
-def _half_turns(yaws: np.ndarray) -> tuple[list[float], list[float]]:
+def _half_turns(yaws: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The z and w of every yaw's quaternion, by :func:`fields.yaw_quaternion`'s own ``math`` calls (numpy's
     sin may differ from the C library's in the last bit: a bag holds what stageros publishes)."""
-    halves = (yaws / 2).tolist()
-    return list(map(math.sin, halves)), list(map(math.cos, halves))
+    halves = (yaws / 2).ravel().tolist()
+    return (np.array(list(map(math.sin, halves))).reshape(yaws.shape),
+            np.array(list(map(math.cos, halves))).reshape(yaws.shape))
 
 
 class _Block:
-    """Messages laid end to end in one buffer, each starting 4 bytes past a multiple of 8: the end of its
-    encapsulation header, where its CDR alignment counts from, falls on the buffer's own 8-byte alignment, so a
-    float64 field of a message is an element of the buffer viewed as float64 (and likewise for 4-byte fields)."""
+    """The messages of a batch of steps laid end to end in one buffer, the endpoints' messages of each step in
+    turn, each starting 4 bytes past a multiple of 8: the end of its encapsulation header, where its CDR
+    alignment counts from, falls on the buffer's own 8-byte alignment, so a float64 field of a message is an
+    element of the buffer viewed as float64 (and likewise for 4-byte fields)."""
 
-    def __init__(self, templates: Sequence[bytes]) -> None:
+    def __init__(self, templates: Sequence[bytes], steps: int) -> None:
+        self.steps = steps
         self.starts: list[int] = []
         at = HEADER
         for template in templates:
             self.starts.append(at)
             at += len(template)
             at += (HEADER - at) % 8
-        self.buffer = bytearray(at)
-        for start, template in zip(self.starts, templates, strict=True):
-            self.buffer[start:start + len(template)] = template
+        self.stride = at - HEADER
+        """Bytes of a step's messages (a multiple of 8)."""
+        self.buffer = bytearray(HEADER + self.stride * steps)
+        for step in range(steps):
+            for start, template in zip(self.starts, templates, strict=True):
+                at = start + step * self.stride
+                self.buffer[at:at + len(template)] = template
         self.spans = [(start, start + len(template)) for start, template in zip(self.starts, templates, strict=True)]
         self.f64 = np.frombuffer(self.buffer, "<f8", len(self.buffer) // 8)
         self.f32 = np.frombuffer(self.buffer, "<f4", len(self.buffer) // 4)
@@ -85,92 +93,109 @@ class _Block:
         self.u32 = np.frombuffer(self.buffer, "<u4", len(self.buffer) // 4)
         self.u8 = np.frombuffer(self.buffer, np.uint8)
 
-    def index(self, offsets: Sequence[int], size: int) -> np.ndarray:
-        """Message k's field at byte ``offsets[k]`` as an index into the buffer's view of ``size``-byte items."""
-        return np.array([(start + offset) // size for start, offset in zip(self.starts, offsets, strict=True)],
-                        dtype=np.intp)
+    def index(self, message: Sequence[int], offsets: Sequence[int], size: int) -> np.ndarray:
+        """(steps, fields): field i, at byte ``offsets[i]`` of message ``message[i]``, of every step, as an index
+        into the buffer's view of ``size``-byte items."""
+        first = np.array([(self.starts[k] + offset) // size for k, offset in zip(message, offsets, strict=True)],
+                         dtype=np.intp)
+        return first[None, :] + (np.arange(self.steps, dtype=np.intp) * (self.stride // size))[:, None]
 
-    def stamp(self, at: np.ndarray, sim_time_us: int) -> None:
-        """Write the stamp (sec, nanosec) at the 4-byte indices ``at``."""
-        sec, nanosec = fields.stamp_parts(sim_time_us)
-        self.i32[at] = sec
-        self.u32[at + 1] = nanosec
+    def stamp(self, at: np.ndarray, sim_times_us: np.ndarray) -> None:
+        """Write each step's stamp (sec, nanosec) at the 4-byte indices ``at`` (steps, fields)."""
+        sec, nanosec = fields.stamp_parts(np.asarray(sim_times_us, dtype=np.int64)[:, None])
+        self.i32[at], self.u32[at + 1] = sec, nanosec
 
-    def messages(self) -> list[bytes]:
-        """Every message's bytes as they are now."""
-        data = bytes(self.buffer)
-        return [data[start:end] for start, end in self.spans]
+    def messages(self, steps: int) -> list[list[bytes | None]]:
+        """Every message's bytes as they are now, per step of the first ``steps``."""
+        data = bytes(self.buffer[:HEADER + steps * self.stride])
+        return [[data[start + step:end + step] for start, end in self.spans]
+                for step in range(0, steps * self.stride, self.stride)]
 
 
 class Layout(ABC):
     """The messages of one per-step topic for each of its recorded endpoints: their template bytes and how a
-    step's values refill them."""
+    batch of steps' values refill them."""
 
     def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
         self._templates, self._endpoints = list(templates), list(endpoints)
-        self._block = _Block(templates)
         self._robots = np.array([e.robot if e.robot is not None else -1 for e in endpoints], dtype=np.intp)
+        self._block = _Block(templates, 0)
+        self._fields: dict[str, np.ndarray] = {}
 
     def __reduce__(self) -> tuple[type[Layout], tuple[list[bytes], list[Endpoint]]]:
         """Pickled as its templates and endpoints (the writer process lays out its own buffer)."""
         return type(self), (self._templates, self._endpoints)
 
-    def _header_stamps(self) -> np.ndarray:
-        """The index of every message's header stamp (right after the encapsulation header)."""
-        return self._block.index([HEADER] * len(self._templates), 4)
+    def _fit(self, steps: int) -> _Block:
+        """The block, grown to hold ``steps`` steps (with the fields' indices made again for it)."""
+        if steps > self._block.steps:
+            self._block = _Block(self._templates, steps)
+            self._fields = self._index(self._block)
+        return self._block
+
+    def _index(self, block: _Block) -> dict[str, np.ndarray]:
+        """The indices of the fields :meth:`refill` writes, per name (steps, fields). Default: every message's
+        header stamp (right after the encapsulation header)."""
+        every = range(len(self._templates))
+        return {"stamp": block.index(every, [HEADER] * len(self._templates), 4)}
 
     @abstractmethod
-    def refill(self, values: Any, sim_time_us: int) -> list[bytes | None]:
-        """Each endpoint's message bytes for this step's ``values`` (the topic's :attr:`Topic.values`), None
-        for an endpoint that publishes nothing this step."""
+    def refill(self, values: Any, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        """Per step, each endpoint's message bytes for the steps' ``values`` (the topic's :attr:`Topic.values`
+        with a leading axis per step), None for an endpoint that publishes nothing in that step."""
 
     def count(self, values: Any) -> int:
         """How many messages :meth:`refill` makes of ``values`` (without making them)."""
-        return len(self._templates)
+        return len(self._templates) * len(_steps_of(values))
+
+
+def _steps_of(values: Any) -> Any:
+    """Something as long as the steps of a topic's batch values."""
+    return values[0] if isinstance(values, tuple) else values
 
 
 class ClockLayout(Layout):
     """rosgraph_msgs/Clock: the stamp is the message."""
 
-    def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
-        super().__init__(templates, endpoints)
-        self._stamps = self._header_stamps()
-
-    def refill(self, values: int, sim_time_us: int) -> list[bytes | None]:
-        self._block.stamp(self._stamps, sim_time_us)
-        return self._block.messages()
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        steps = len(sim_times_us)
+        block = self._fit(steps)
+        block.stamp(self._fields["stamp"][:steps], sim_times_us)
+        return block.messages(steps)
 
 
 class BoolLayout(Layout):
     """std_msgs/Bool of a robot (stall): one byte."""
 
-    def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
-        super().__init__(templates, endpoints)
-        self._data = self._block.index([HEADER] * len(templates), 1)
+    def _index(self, block: _Block) -> dict[str, np.ndarray]:
+        return {"data": block.index(range(len(self._templates)), [HEADER] * len(self._templates), 1)}
 
-    def refill(self, values: np.ndarray, sim_time_us: int) -> list[bytes | None]:
-        self._block.u8[self._data] = values[self._robots]
-        return self._block.messages()
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        steps = len(sim_times_us)
+        block = self._fit(steps)
+        block.u8[self._fields["data"][:steps]] = values[:, self._robots]
+        return block.messages(steps)
 
 
 class OdometryLayout(Layout):
     """nav_msgs/Odometry of a robot (odom, ground truth): stamp, planar pose and velocity; covariances 0."""
 
-    def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
-        super().__init__(templates, endpoints)
-        self._stamps = self._header_stamps()
-        poses = [_aligned(_after_string(t, _after_header(t, HEADER)), 8) for t in templates]
-        self._pose = self._block.index(poses, 8)
-        self._twist = self._block.index([pose + (7 + 36) * 8 for pose in poses], 8)  # after pose and covariance
+    def _index(self, block: _Block) -> dict[str, np.ndarray]:
+        every = range(len(self._templates))
+        poses = [_aligned(_after_string(t, _after_header(t, HEADER)), 8) for t in self._templates]
+        return {**super()._index(block), "pose": block.index(every, poses, 8),
+                "twist": block.index(every, [pose + (7 + 36) * 8 for pose in poses], 8)}  # after the covariance
 
-    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_time_us: int) -> list[bytes | None]:
-        poses, velocities = values[0][self._robots], values[1][self._robots]
-        f64, pose, twist = self._block.f64, self._pose, self._twist
-        self._block.stamp(self._stamps, sim_time_us)
-        f64[pose], f64[pose + _Y] = poses[:, 0], poses[:, 1]
-        f64[pose + _QZ], f64[pose + _QW] = _half_turns(poses[:, 2])
-        f64[twist], f64[twist + _VY], f64[twist + _WZ] = velocities[:, 0], velocities[:, 1], velocities[:, 2]
-        return self._block.messages()
+    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        steps = len(sim_times_us)
+        block = self._fit(steps)
+        poses, velocities = values[0][:, self._robots], values[1][:, self._robots]
+        f64, pose, twist = block.f64, self._fields["pose"][:steps], self._fields["twist"][:steps]
+        block.stamp(self._fields["stamp"][:steps], sim_times_us)
+        f64[pose], f64[pose + _Y] = poses[..., 0], poses[..., 1]
+        f64[pose + _QZ], f64[pose + _QW] = _half_turns(poses[..., 2])
+        f64[twist], f64[twist + _VY], f64[twist + _WZ] = velocities[..., 0], velocities[..., 1], velocities[..., 2]
+        return block.messages(steps)
 
 
 class ScanLayout(Layout):
@@ -178,89 +203,97 @@ class ScanLayout(Layout):
 
     def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
         super().__init__(templates, endpoints)
-        self._stamps = self._header_stamps()
-        counts = [_aligned(_after_header(t, HEADER), 4) + 7 * 4 for t in templates]  # after angle_min ... range_max
-        self._beams = [_COUNT.unpack_from(t, count)[0] for t, count in zip(templates, counts, strict=True)]
+        self._counts = [_aligned(_after_header(t, HEADER), 4) + 7 * 4 for t in templates]  # after range_max
+        self._beams = [_COUNT.unpack_from(t, count)[0] for t, count in zip(templates, self._counts, strict=True)]
         self._slots = [(e.robot, e.ranger) for e in endpoints]
         self._first_beam = np.cumsum([0, *self._beams]).tolist()
-        """Where each endpoint's beams start in the index arrays below."""
-        self._ranges = self._beam_index([count + 4 for count in counts])
-        self._intensities = self._beam_index([count + 8 + 4 * beams for count, beams in zip(counts, self._beams,
-                                                                                               strict=True)])
-        self._source: tuple[list[int], np.ndarray | None] = ([], None)
-        """The scans' positions in the last step's packed arrays, and the gather index they make (None: the
-        packed arrays are the endpoints' beams in order)."""
+        """Where each endpoint's beams start in the beam indices."""
+        self._gather: tuple[tuple[int, ...], tuple[int, ...], np.ndarray | None] | None = None
+        """For the last batch's scan layout (first, lengths): the gather index of the endpoints' beams out of a
+        step's row (None: the row is the endpoints' beams in order)."""
 
-    def _beam_index(self, offsets: list[int]) -> np.ndarray:
-        """The float32 indices of every message's beams from its first at ``offsets``, end to end."""
-        firsts = self._block.index(offsets, 4)
-        return np.concatenate([np.arange(first, first + beams) for first, beams in zip(firsts, self._beams,
-                                                                                         strict=True)])
+    def _index(self, block: _Block) -> dict[str, np.ndarray]:
+        return {**super()._index(block), "ranges": self._beam_index(block, [count + 4 for count in self._counts]),
+                "intensities": self._beam_index(block, [count + 8 + 4 * beams for count, beams
+                                                        in zip(self._counts, self._beams, strict=True)])}
 
-    def _starts(self, values: PackedScans) -> list[int]:
-        """Where each endpoint's scan starts in the step's packed arrays (-1: it took none)."""
-        first, offsets = values.first, values.offsets
-        return [offsets[first[robot] + ranger] for robot, ranger in self._slots]
+    def _beam_index(self, block: _Block, offsets: list[int]) -> np.ndarray:
+        """(steps, beams of all endpoints): the float32 indices of every message's beams, from its first at
+        ``offsets``, end to end."""
+        firsts = block.index(range(len(offsets)), offsets, 4)
+        within = np.concatenate([np.arange(beams, dtype=np.intp) for beams in self._beams]) if self._beams else \
+            np.zeros(0, np.intp)
+        return np.repeat(firsts, self._beams, axis=1) + within
 
-    def refill(self, values: PackedScans, sim_time_us: int) -> list[bytes | None]:
-        starts = self._starts(values)
-        if -1 in starts:
-            return self._refill_measured(values, starts, sim_time_us)
-        if starts != self._source[0]:
-            in_order = starts == self._first_beam[:-1] and self._first_beam[-1] == len(values.ranges)
+    def _in_rows(self, rows: ScanRows) -> np.ndarray | None:
+        """Where the endpoints' beams are in a step's row when every ranger measured (None: the row in order)."""
+        if self._gather is None or self._gather[:2] != (rows.first, rows.lengths):
+            starts = np.cumsum([0, *rows.lengths]).tolist()
+            at = [starts[rows.first[robot] + ranger] for robot, ranger in self._slots]
+            in_order = at == self._first_beam[:-1] and self._first_beam[-1] == starts[-1]
             gather = None if in_order else np.concatenate(
-                [np.arange(start, start + beams) for start, beams in zip(starts, self._beams, strict=True)])
-            self._source = (starts, gather)
-        gather = self._source[1]
-        block = self._block
-        block.stamp(self._stamps, sim_time_us)
-        if gather is None:
-            block.f32[self._ranges], block.f32[self._intensities] = values.ranges, values.intensities
-        else:
-            block.f32[self._ranges], block.f32[self._intensities] = values.ranges[gather], values.intensities[gather]
-        return block.messages()
+                [np.arange(start, start + beams) for start, beams in zip(at, self._beams, strict=True)])
+            self._gather = (rows.first, rows.lengths, gather)
+        return self._gather[2]
 
-    def _refill_measured(self, values: PackedScans, starts: list[int], sim_time_us: int) -> list[bytes | None]:
-        """A step in which some rangers took no scan (they are slower than the step): those that did, one by
+    def refill(self, values: ScanRows, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        steps = len(sim_times_us)
+        block = self._fit(steps)
+        if not values.measured.all():
+            return [self._refill_step(values.row(k), k, time) for k, time in enumerate(sim_times_us.tolist())]
+        gather = self._in_rows(values)
+        ranges, intensities = (values.ranges, values.intensities) if gather is None else (
+            values.ranges[:, gather], values.intensities[:, gather])
+        block.stamp(self._fields["stamp"][:steps], sim_times_us)
+        block.f32[self._fields["ranges"][:steps]], block.f32[self._fields["intensities"][:steps]] = ranges, intensities
+        return block.messages(steps)
+
+    def _refill_step(self, scans: PackedScans, step: int, sim_time_us: int) -> list[bytes | None]:
+        """One step in which some rangers took no scan (they are slower than the step): those that did, one by
         one."""
         block, out = self._block, []
-        for k, (start, beams) in enumerate(zip(starts, self._beams, strict=True)):
+        first, offsets = scans.first, scans.offsets
+        for k, (robot, ranger) in enumerate(self._slots):
+            start = offsets[first[robot] + ranger]
             if start < 0:
                 out.append(None)
                 continue
+            beams = self._beams[k]
             beam = slice(self._first_beam[k], self._first_beam[k] + beams)
-            block.stamp(self._stamps[k:k + 1], sim_time_us)
-            block.f32[self._ranges[beam]] = values.ranges[start:start + beams]
-            block.f32[self._intensities[beam]] = values.intensities[start:start + beams]
+            block.stamp(self._fields["stamp"][step:step + 1, k:k + 1], np.array([sim_time_us]))
+            block.f32[self._fields["ranges"][step, beam]] = scans.ranges[start:start + beams]
+            block.f32[self._fields["intensities"][step, beam]] = scans.intensities[start:start + beams]
             begin, end = block.spans[k]
-            out.append(bytes(block.buffer[begin:end]))
+            at = step * block.stride
+            out.append(bytes(block.buffer[begin + at:end + at]))
         return out
 
-    def count(self, values: PackedScans) -> int:
-        return sum(start >= 0 for start in self._starts(values))
+    def count(self, values: ScanRows) -> int:
+        measured = values.measured[:, [values.first[robot] + ranger for robot, ranger in self._slots]]
+        return int(np.count_nonzero(measured))
 
 
 class TransformsLayout(Layout):
     """tf2_msgs/TFMessage of every robot's odom → base_footprint: per transform, stamp, x, y and yaw."""
 
-    def __init__(self, templates: Sequence[bytes], endpoints: Sequence[Endpoint]) -> None:
-        super().__init__(templates, endpoints)
-        stamps, translations = [], []
-        for start, template in zip(self._block.starts, templates, strict=True):
+    def _index(self, block: _Block) -> dict[str, np.ndarray]:
+        message, stamps, translations = [], [], []
+        for k, template in enumerate(self._templates):
             offset = HEADER + 4  # after the sequence count
             for _ in range(_COUNT.unpack_from(template, HEADER)[0]):
-                stamps.append((start + _aligned(offset, 4)) // 4)
+                message.append(k)
+                stamps.append(_aligned(offset, 4))
                 translation = _aligned(_after_string(template, _after_header(template, offset)), 8)
-                translations.append((start + translation) // 8)
+                translations.append(translation)
                 offset = translation + 7 * 8
-        self._stamps = np.array(stamps, dtype=np.intp)
-        self._translations = np.array(translations, dtype=np.intp)
-        self._copies = len(templates)
+        return {"stamp": block.index(message, stamps, 4), "translation": block.index(message, translations, 8)}
 
-    def refill(self, values: np.ndarray, sim_time_us: int) -> list[bytes | None]:
-        poses = values if self._copies == 1 else np.tile(values, (self._copies, 1))
-        f64, at = self._block.f64, self._translations
-        self._block.stamp(self._stamps, sim_time_us)
-        f64[at], f64[at + _Y] = poses[:, 0], poses[:, 1]
-        f64[at + _QZ], f64[at + _QW] = _half_turns(poses[:, 2])
-        return self._block.messages()
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+        steps = len(sim_times_us)
+        block = self._fit(steps)
+        poses = np.tile(values, (1, len(self._templates), 1))  # every message holds every robot's
+        f64, at = block.f64, self._fields["translation"][:steps]
+        block.stamp(self._fields["stamp"][:steps], sim_times_us)
+        f64[at], f64[at + _Y] = poses[..., 0], poses[..., 1]
+        f64[at + _QZ], f64[at + _QW] = _half_turns(poses[..., 2])
+        return block.messages(steps)

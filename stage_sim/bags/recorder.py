@@ -168,7 +168,7 @@ class BagRecorder:
         except queue.Full:
             if not (wait and self._wait_for_room(batch)):
                 self.dropped_steps += batch.count
-                self.dropped_messages += sum(self._messages.publications(state) for state in batch.steps())
+                self.dropped_messages += self._messages.publications(batch)
 
     def _wait_for_room(self, batch: StepBatch) -> bool:
         """Queue ``batch`` once the writer has made room; False if the recording stopped meanwhile."""

@@ -10,10 +10,12 @@ second.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from stage_sim.bags.layouts import Layout
-from stage_sim.bags.step_state import StepState
+from stage_sim.bags.step_state import StepBatch
+from stage_sim.interface import fields
 from stage_sim.interface.topics import Topic
 
 
@@ -29,7 +31,7 @@ class StepChannel:
 
 @dataclass
 class StepMessages:
-    """Turns :class:`StepState` into (bag topic, log time ns, CDR bytes), as stageros publishes each step."""
+    """Turns a :class:`StepBatch` into each step's (bag topic, CDR bytes), as stageros publishes each step."""
 
     channels: list[StepChannel]
     stepped: tuple[Topic, ...] = field(init=False)
@@ -39,16 +41,20 @@ class StepMessages:
     def __post_init__(self) -> None:
         self.stepped = tuple(channel.topic for channel in self.channels)
 
-    def step(self, state: StepState) -> list[tuple[str, bytes]]:
-        """Everything one step publishes on the recorded topics (bag topic, CDR bytes), in stageros'
-        publishing order; their log time is the step's stamp."""
-        sim_time_us = state.sim_time_us
-        messages = []
-        for channel, values in zip(self.channels, state.values, strict=True):
-            refilled = channel.layout.refill(values, sim_time_us)
-            messages += [(name, data) for name, data in zip(channel.names, refilled, strict=True) if data is not None]
-        return messages
+    def steps(self, batch: StepBatch) -> Iterator[tuple[int, list[tuple[str, bytes]]]]:
+        """Per step of ``batch``, its log time (ns) and everything it published on the recorded topics (bag topic,
+        CDR bytes), in stageros' publishing order. Each topic's messages are refilled for the whole batch at
+        once."""
+        times = batch.times
+        refilled = [channel.layout.refill(values, times) for channel, values
+                    in zip(self.channels, batch.values(), strict=True)]
+        for k, time in enumerate(times.tolist()):
+            messages = []
+            for channel, topic_messages in zip(self.channels, refilled, strict=True):
+                messages += [(name, data) for name, data in zip(channel.names, topic_messages[k], strict=True)
+                             if data is not None]
+            yield fields.stamp_ns(time), messages
 
-    def publications(self, state: StepState) -> int:
-        """How many messages :meth:`step` makes of ``state`` (without building them)."""
-        return sum(channel.layout.count(values) for channel, values in zip(self.channels, state.values, strict=True))
+    def publications(self, batch: StepBatch) -> int:
+        """How many messages :meth:`steps` makes of ``batch`` (without making them)."""
+        return sum(channel.layout.count(values) for channel, values in zip(self.channels, batch.values(), strict=True))

@@ -47,6 +47,29 @@ class PackedScans:
 
 
 @dataclass(frozen=True)
+class ScanRows:
+    """The scans of a batch of steps: per step (row), the beams of every ranger that measured, end to end, and
+    which rangers measured."""
+
+    first: tuple[int, ...]
+    """(robots + 1,) index of each robot's first ranger in ``lengths``."""
+    lengths: tuple[int, ...]
+    ranges: np.ndarray
+    """float32 (steps, beams of all rangers)."""
+    intensities: np.ndarray
+    measured: np.ndarray
+    """bool (steps, rangers)."""
+
+    def row(self, k: int) -> PackedScans:
+        """Step ``k``'s scans."""
+        offsets, at = [], 0
+        for measured, length in zip(self.measured[k].tolist(), self.lengths, strict=True):
+            offsets.append(at if measured else -1)
+            at += length if measured else 0
+        return PackedScans(self.first, offsets, self.lengths, self.ranges[k], self.intensities[k])
+
+
+@dataclass(frozen=True)
 class StepState:
     """What one step published: its sim time and the values (:attr:`Topic.values`) of the recorded per-step
     topics, in their order (a list, not a dict by topic: hashing a Topic, a dataclass of enums, per step cost
@@ -69,7 +92,11 @@ class _Column(ABC):
 
     @abstractmethod
     def row(self, k: int) -> Any:
-        """Step ``k``'s value, as the topic's layout reads it."""
+        """Step ``k``'s value."""
+
+    @abstractmethod
+    def rows(self, count: int) -> Any:
+        """The first ``count`` steps' values at once, a leading axis per step: what a topic's layout reads."""
 
     @abstractmethod
     def head(self, count: int) -> _Column:
@@ -97,6 +124,9 @@ class _Array(_Column):
     def row(self, k: int) -> Any:
         return self.data[k] if self.data.ndim > 1 else self.data[k].item()
 
+    def rows(self, count: int) -> np.ndarray:
+        return self.data[:count]
+
     def head(self, count: int) -> _Array:
         return _Array(self.data[:count])
 
@@ -116,6 +146,9 @@ class _Tuple(_Column):
 
     def row(self, k: int) -> tuple:
         return tuple(part.row(k) for part in self.parts)
+
+    def rows(self, count: int) -> tuple:
+        return tuple(part.rows(count) for part in self.parts)
 
     def head(self, count: int) -> _Tuple:
         return _Tuple([part.head(count) for part in self.parts])
@@ -149,11 +182,11 @@ class _Scans(_Column):
                 beams.intensities[beams.ray_due]
 
     def row(self, k: int) -> PackedScans:
-        offsets, at = [], 0
-        for measured, length in zip(self.measured[k].tolist(), self.lengths, strict=True):
-            offsets.append(at if measured else -1)
-            at += length if measured else 0
-        return PackedScans(self.first, offsets, self.lengths, self.ranges[k], self.intensities[k])
+        return self.rows(k + 1).row(k)
+
+    def rows(self, count: int) -> ScanRows:
+        return ScanRows(self.first, self.lengths, self.ranges[:count], self.intensities[:count],
+                        self.measured[:count])
 
     def head(self, count: int) -> _Scans:
         head = _Scans(self.first, self.lengths, 0)
@@ -203,8 +236,17 @@ class StepBatch:
             column.put(k, topic.values(sim, names))
         self.count += 1
 
+    @property
+    def times(self) -> np.ndarray:
+        """The sim time (µs) of each step held, in order."""
+        return self._times.rows(self.count)
+
+    def values(self) -> list[Any]:
+        """Each topic's values for all the steps held (a leading axis per step), in the topics' order."""
+        return [column.rows(self.count) for column in self._columns]
+
     def steps(self) -> Iterator[StepState]:
-        """The steps held, in order."""
+        """The steps held, in order, one by one."""
         for k in range(self.count):
             yield StepState(self._times.row(k), [column.row(k) for column in self._columns])
 

@@ -33,7 +33,6 @@ from stage_sim.bags.errors import BagError
 from stage_sim.bags.step_messages import StepMessages
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import Topic
-from stage_sim.interface import fields
 
 
 @dataclass(frozen=True)
@@ -132,16 +131,17 @@ class _Writer:
     def steps(self, batch: StepBatch) -> None:
         """Write the batch's steps, unless an earlier write failed (then they are dropped: the recording has
         stopped)."""
-        for state in batch.steps():
-            if self.error is not None:
-                return
-            self.last_us = state.sim_time_us
+        if self.error is not None:
+            return
+        for log_time, messages in self._messages.steps(batch):
             try:
-                self.write(fields.stamp_ns(state.sim_time_us), self._messages.step(state))
+                self.write(log_time, messages)
             except OSError as exc:
-                self.error = f"{exc.strerror or exc} at sim time {state.sim_time_us / 1e6:g} s"
+                self.error = f"{exc.strerror or exc} at sim time {log_time / 1e9:g} s"
                 self.bag.abort()
                 _report(self._reports, Failed(self.error))
+                return
+            self.last_us = log_time // 1000
 
 
 def main(argv: list[str]) -> None:

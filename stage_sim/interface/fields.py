@@ -20,7 +20,8 @@ if TYPE_CHECKING:
 
 
 def stamp_parts(sim_time_us: int) -> tuple[int, int]:
-    """(sec, nanosec) of a sim time in integer microseconds: exact, no float rounding."""
+    """(sec, nanosec) of a sim time in integer microseconds: exact, no float rounding (also of an int64 array
+    of them, element by element)."""
     return sim_time_us // 1_000_000, (sim_time_us % 1_000_000) * 1000
 
 

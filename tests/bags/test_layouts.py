@@ -4,6 +4,7 @@ endpoint of every per-step topic (clock, odom, ground truth, stall, scans, tf), 
 from __future__ import annotations
 
 import pickle
+from pathlib import Path
 
 import pytest
 
@@ -12,8 +13,9 @@ from stage_sim.bags.step_state import StepBatch
 from stage_sim.interface import topics
 from stage_sim.interface.topics import Timing
 from stage_sim.sim.simulation import Simulation
-from stage_sim.worldfile.loader import load_world
+from stage_sim.worldfile.loader import load_world, load_world_text
 from tests.bags.test_recorder import COMMANDS, names_of
+from tests.bags.test_step_state import WORLD as RATES_WORLD
 from tests.bags.worlds import two_robot_world
 
 STEPPED = [t for t in topics.PUBLISHED if t.timing is not Timing.START]
@@ -23,12 +25,20 @@ def test_every_per_step_topic_has_a_layout() -> None:
     assert set(LAYOUTS) == set(STEPPED)
 
 
+def _world(name: str, tmp_path: Path) -> Simulation:
+    if name == "two robots":
+        return Simulation(load_world(two_robot_world(tmp_path)), seed=5)
+    return Simulation(load_world_text(RATES_WORLD, str(tmp_path / "rates.world")), seed=5)
+
+
+@pytest.mark.parametrize("world", ["two robots", "rangers at different rates"])
 @pytest.mark.parametrize("chosen", ["every endpoint", "the last endpoints first"])
 @pytest.mark.parametrize("topic", STEPPED, ids=lambda t: t.name)
-def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen) -> None:
+def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen, world) -> None:
     """Also with the endpoints recorded in another order than the simulation's (a bag of chosen topics):
-    a topic's layout then gathers each one's values from where they are."""
-    sim = Simulation(load_world(two_robot_world(tmp_path)), seed=5)
+    a topic's layout then gathers each one's values from where they are; and with rangers slower than the
+    step, which skip steps, and a robot without any."""
+    sim = _world(world, tmp_path)
     names = names_of(sim)
     endpoints = topics.endpoints(topic, names)
     if chosen != "every endpoint":
@@ -37,21 +47,24 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen) -
     layout = pickle.loads(pickle.dumps(LAYOUTS[topic]([template(topic, e, sim, names) for e in endpoints], endpoints)))
     messages = [TOPIC_MESSAGES[topic].build(e, sim, names) for e in endpoints]
     for robot, command in enumerate(COMMANDS):
-        sim.set_velocity(robot, *command)
+        if robot < len(sim.robots):
+            sim.set_velocity(robot, *command)
     compared = 0
-    for _ in range(12):
-        sim.step()
-        batch = StepBatch.first(sim, names, [topic], 1)
-        batch.capture(sim, names, [topic])
-        ((captured,),) = [state.values for state in pickle.loads(pickle.dumps(batch)).steps()]
-        values = topic.values(sim, names)
-        refilled_all = layout.refill(captured, sim.sim_time_us)
-        assert layout.count(captured) == sum(data is not None for data in refilled_all)
-        for endpoint, refilled, msg in zip(endpoints, refilled_all, messages, strict=True):
-            filled = TOPIC_MESSAGES[topic].fill(msg, values, endpoint, _time(sim.sim_time_us))
-            if filled is None:
-                assert refilled is None
-                continue
-            assert refilled == TYPESTORE.serialize_cdr(filled, topic.msgtype), endpoint.name
-            compared += 1
+    for size in (5, 1, 4, 2):  # batches of several sizes, the layout's buffer grown and reused
+        batch = StepBatch.first(sim, names, [topic], size)
+        expected = []
+        for _ in range(size):
+            sim.step()
+            batch.capture(sim, names, [topic])
+            values, stamp = topic.values(sim, names), _time(sim.sim_time_us)
+            filled = [TOPIC_MESSAGES[topic].fill(msg, values, e, stamp) for e, msg in zip(endpoints, messages,
+                                                                                          strict=True)]
+            expected.append([None if msg is None else bytes(TYPESTORE.serialize_cdr(msg, topic.msgtype))
+                             for msg in filled])
+        received = pickle.loads(pickle.dumps(batch))
+        (values,) = received.values()
+        refilled = layout.refill(values, received.times)
+        assert refilled == expected
+        assert layout.count(values) == sum(data is not None for step in expected for data in step)
+        compared += sum(data is not None for step in expected for data in step)
     assert compared >= 12 * len(endpoints) // 2  # scans too: the rangers measure in most steps
