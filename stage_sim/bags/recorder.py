@@ -17,6 +17,7 @@ goes on and the file stays readable up to its last chunk.
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import queue
 import subprocess
@@ -129,6 +130,9 @@ class BagRecorder:
         self._queue: queue.Queue[StepBatch | None] = queue.Queue(
             maxsize=max(2, QUEUE_BYTES // (self._batch_steps * step_bytes)))
         self._pending = StepBatch.first(sim, names, self._messages.stepped, self._batch_steps)
+        self._spare: queue.SimpleQueue[StepBatch] = queue.SimpleQueue()
+        """Batches the sender has sent, to be filled again: their memory is already mapped (a fresh 1 MiB batch
+        costs the stepping thread a page fault every 4 kB it fills)."""
         self._pending_since = 0.0
         self._thread = threading.Thread(target=self._send, name="bag-sender", daemon=True)
         self._thread.start()
@@ -160,7 +164,7 @@ class BagRecorder:
 
     def _hand_over(self, wait: bool) -> None:
         """Queue the pending steps; when the queue is full, wait for room if ``wait``, else drop them."""
-        batch, self._pending = self._pending, self._pending.empty(self._batch_steps)
+        batch, self._pending = self._pending, self._empty_batch()
         if self.failed:
             return
         try:
@@ -169,6 +173,16 @@ class BagRecorder:
             if not (wait and self._wait_for_room(batch)):
                 self.dropped_steps += batch.count
                 self.dropped_messages += self._messages.publications(batch)
+                self._spare.put(batch)
+
+    def _empty_batch(self) -> StepBatch:
+        """A batch to fill: a spare one, else a new one."""
+        try:
+            batch = self._spare.get_nowait()
+        except queue.Empty:
+            return self._pending.empty(self._batch_steps)
+        batch.clear()
+        return batch
 
     def _wait_for_room(self, batch: StepBatch) -> bool:
         """Queue ``batch`` once the writer has made room; False if the recording stopped meanwhile."""
@@ -218,6 +232,7 @@ class BagRecorder:
                     send_batch(self._steps, batch)
                 except OSError:
                     self._writer_lost = True
+            self._spare.put(batch)
             self._read_reports()
 
     def _next_report(self, timeout: float | None) -> Opened | Failed | Closed | None:
@@ -258,11 +273,19 @@ class BagRecorder:
         return f"the writer process exited with status {code}"
 
 
+def _widen(pipe: int) -> None:
+    """Let the steps pipe hold a whole batch (BATCH_BYTES; Linux: as far as the system's pipe-max-size allows),
+    so that sending one wakes the writer once, not once per 64 kB of the default pipe."""
+    with contextlib.suppress(AttributeError, OSError):  # not Linux, or a lower limit: the default pipe works
+        fcntl.fcntl(pipe, fcntl.F_SETPIPE_SZ, BATCH_BYTES)
+
+
 def _start_writer() -> tuple[subprocess.Popen, Connection, Connection]:
     """Start the writer process (:mod:`stage_sim.bags.writer`) with a pipe for steps and one for its reports;
     the writer holds the only reading end of the first, so a killed simulation ends its input."""
     steps_in, steps_out = os.pipe()
     reports_in, reports_out = os.pipe()
+    _widen(steps_out)
     root = str(Path(__file__).resolve().parents[2])  # where this stage_sim is, however the caller found it
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
     try:

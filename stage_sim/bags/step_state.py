@@ -224,6 +224,10 @@ class StepBatch:
         """An empty batch like this one (the stepping side starts one as it hands the last over)."""
         return StepBatch(self._times, self._columns, size)
 
+    def clear(self) -> None:
+        """Empty this batch to fill it again (its arrays are kept: the sender has sent their contents)."""
+        self.count = 0
+
     @property
     def full(self) -> bool:
         return self.count == len(self._times.data)
