@@ -273,6 +273,12 @@ class BagRecorder:
         return f"the writer process exited with status {code}"
 
 
+WRITER_MAIN = "import sys; sys.path[0] = sys.argv.pop(1); from stage_sim.bags.writer import main; main(sys.argv[1:])"
+"""The writer process's program: :func:`stage_sim.bags.writer.main` of this very stage_sim (its folder replaces
+the working directory at the head of the path, where another checkout of stage_sim may be: the writer would
+then read this one's plan with other code)."""
+
+
 def _widen(pipe: int) -> None:
     """Let the steps pipe hold a whole batch (BATCH_BYTES; Linux: as far as the system's pipe-max-size allows),
     so that sending one wakes the writer once, not once per 64 kB of the default pipe."""
@@ -287,10 +293,9 @@ def _start_writer() -> tuple[subprocess.Popen, Connection, Connection]:
     reports_in, reports_out = os.pipe()
     _widen(steps_out)
     root = str(Path(__file__).resolve().parents[2])  # where this stage_sim is, however the caller found it
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
     try:
-        process = subprocess.Popen([sys.executable, "-m", "stage_sim.bags", str(steps_in), str(reports_out)],
-                                   pass_fds=(steps_in, reports_out), stdin=subprocess.DEVNULL, env=env)
+        process = subprocess.Popen([sys.executable, "-c", WRITER_MAIN, root, str(steps_in), str(reports_out)],
+                                   pass_fds=(steps_in, reports_out), stdin=subprocess.DEVNULL)
     finally:
         os.close(steps_in)
         os.close(reports_out)

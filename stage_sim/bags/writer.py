@@ -5,7 +5,7 @@ as simulating it, and a thread shares the simulation's GIL (recording then cost 
 process of its own it runs on another core, and the stepping side only copies each step
 (:class:`~stage_sim.bags.step_state.StepBatch`) and sends batches of steps through a pipe.
 
-The process is ``python -m stage_sim.bags STEPS REPORTS`` (:mod:`stage_sim.bags.__main__`): a fresh
+The process runs :func:`main` with ``STEPS REPORTS`` (:data:`stage_sim.bags.recorder.WRITER_MAIN`): a fresh
 interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would re-run
 the user's main script. STEPS and REPORTS are its two pipes' file descriptors; what goes through them is
 pickled by :mod:`multiprocessing.connection`, a batch's arrays out of band (:class:`BatchFrame`). It first

@@ -249,6 +249,23 @@ def test_a_stalled_writer_at_real_time_drops_steps_instead_of_stalling_and_the_b
                                "dropped_messages": str(summary.dropped_messages)}
 
 
+def test_the_writer_is_this_stage_sim_whatever_the_working_directory_holds(tmp_path, monkeypatch) -> None:
+    """A recording started from a folder that holds another stage_sim (a checkout of another version) still
+    gets a writer of its own code: the working directory is not first on the writer's path."""
+    world = load_world(two_robot_world(tmp_path))
+    other = tmp_path / "checkout" / "stage_sim"
+    other.mkdir(parents=True)
+    (other / "__init__.py").write_text('raise ImportError("the stage_sim of the working directory")\n')
+    monkeypatch.chdir(other.parent)
+    sim = Simulation(world, seed=1)
+    recorder = BagRecorder(sim, tmp_path / "run.mcap", names_of(sim), speedup=0.0)
+    for _ in range(3):
+        sim.step()
+        recorder.record_step()
+    summary = recorder.close()
+    assert summary.complete and READERS["mcap"](tmp_path / "run.mcap").counts()["/clock"] == 3
+
+
 def test_a_writer_that_dies_ends_the_recording_with_a_message_and_the_run_goes_on(tmp_path) -> None:
     sim = Simulation(load_world(two_robot_world(tmp_path)), seed=1)
     recorder = BagRecorder(sim, tmp_path / "run.mcap", names_of(sim), speedup=0.0)
