@@ -147,14 +147,16 @@ class McapBag:
         except OSError as exc:
             self.abort()
             raise BagError(f"cannot write bag {path}: {exc.strerror or exc}") from None
-        schemas: dict[str, foxglove.Schema] = {}
+        schemas: dict[str, tuple[foxglove.Schema, str]] = {}
+        """Per message type, once: its schema and its type hash."""
         for topic in topics:
             if topic.msgtype not in schemas:
                 text, _ = TYPESTORE.generate_msgdef(topic.msgtype, ros_version=2)
-                schemas[topic.msgtype] = foxglove.Schema(name=topic.msgtype, encoding="ros2msg", data=text.encode())
-            metadata = {"offered_qos_profiles": topic.offered_qos_profiles(),
-                        "topic_type_hash": TYPESTORE.hash_rihs01(topic.msgtype)}
-            self._channels[topic.name] = foxglove.Channel(topic.name, schema=schemas[topic.msgtype],
+                schemas[topic.msgtype] = (foxglove.Schema(name=topic.msgtype, encoding="ros2msg", data=text.encode()),
+                                          TYPESTORE.hash_rihs01(topic.msgtype))
+            schema, type_hash = schemas[topic.msgtype]
+            metadata = {"offered_qos_profiles": topic.offered_qos_profiles(), "topic_type_hash": type_hash}
+            self._channels[topic.name] = foxglove.Channel(topic.name, schema=schema,
                                                           message_encoding="cdr", context=self._context,
                                                           metadata=metadata)
         # The channels' own log(data, log_time), without the wrapper's checks for JSON and str messages.
