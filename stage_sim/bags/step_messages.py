@@ -1,11 +1,11 @@
-"""What the bag writer process needs to turn a step into its messages, without the simulation.
+"""What the bag writer process needs to turn steps into their messages, without the simulation.
 
-The stepping side copies each step into a :class:`~stage_sim.bags.step_state.StepBatch` (a few array copies)
-and sends batches of steps to the writer process (:mod:`stage_sim.bags.writer`), which refills each endpoint's
-CDR bytes from it (:class:`StepMessages`, the per-step part of :class:`stage_sim.bags.messages.MessageBuilder`,
-sent to the writer once: its layouts travel as their template bytes, its endpoints as registry references).
-This module imports neither the simulation nor its kernels: the writer process starts in a fraction of a
-second.
+The stepping side copies each step into a :class:`~stage_sim.bags.step_state.StepBatch` (a few array copies) and
+sends batches of steps to the writer process (:mod:`stage_sim.bags.writer`), which refills every endpoint's CDR
+bytes from a whole batch at once, topic by topic (:class:`StepMessages`, the per-step part of
+:class:`stage_sim.bags.messages.MessageBuilder`, sent to the writer once: its layouts travel as their template
+bytes, its endpoints as registry references). This module imports neither the simulation nor its kernels: the
+writer process starts in a fraction of a second.
 """
 
 from __future__ import annotations

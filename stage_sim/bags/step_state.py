@@ -3,7 +3,8 @@
 The stepping side copies each step into a :class:`StepBatch`, column by column (one preallocated array per
 value of a per-step topic, a row per step), and sends the batch whole: a step costs it a few array copies, and
 pickling a batch a few arrays however many steps it holds (a step's values pickled one by one cost about as
-much as simulating a one-robot step). The writer reads the batch back step by step, as :class:`StepState`.
+much as simulating a one-robot step). The writer reads each topic's values for all the batch's steps at once
+(:meth:`StepBatch.values`), or step by step (:class:`StepState`).
 """
 
 from __future__ import annotations
