@@ -31,6 +31,7 @@ from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame
 from stage_sim.sim.drives import DriveGroup
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import integrate_odometry
+from stage_sim.sim.ray_groups import SingleCast
 from stage_sim.sim.returns import hit_intensity
 
 
@@ -71,6 +72,27 @@ class Motion(Protocol):
         ...
 
 
+class Fused(Protocol):
+    """A whole step in few calls, as the roles give it step by step (:meth:`~stage_sim.sim.compiled.FusedStep.step`)."""
+
+    def step(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(new poses, stall flags, odometry, layer poses, float32 ranges and intensities of every beam)."""
+        ...
+
+
+class FusedFactory(Protocol):
+    """The fused step of a world's contacts and rays (:meth:`~stage_sim.sim.rangers.RangerSensing.single_cast`)
+    on ``threads``, or None where it steps role by role."""
+
+    def __call__(self, collision: Contact, cast: SingleCast | None, threads: int) -> Fused | None: ...
+
+
+def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int) -> None:
+    """The numpy reference steps role by role: it is what every fused step must give."""
+
+
 class HitIntensity(Protocol):
     """Writes each ray's return intensity (:func:`~stage_sim.sim.returns.hit_intensity`)."""
 
@@ -109,17 +131,19 @@ class Backend:
     contact: ContactFactory
     motion: Motion
     hit_intensity: HitIntensity
+    fused: FusedFactory
 
 
 def _numpy() -> Backend:
-    return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity)
+    return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity,
+                   no_fused_step)
 
 
 def _numba() -> Backend:
     from stage_sim.sim import compiled  # imports numba
 
     return Backend("numba", partial(make_caster, kernels="numba"), compiled.CompiledCollisionChecker,
-                   compiled.CompiledMotion(), compiled.hit_intensity)
+                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of)
 
 
 #: Every backend by name, built on first request.

@@ -16,10 +16,12 @@ import numpy as np
 
 from stage_sim.backend import set_threads
 from stage_sim.maps.tiles import CellValues
-from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
-from stage_sim.sim import body_kernels, motion_kernels, ranger_kernels
-from stage_sim.sim.collision import CollisionChecker
+from stage_sim.sensing.fast_caster import PARALLEL_RAYS
+from stage_sim.sensing.robot_layer import MARKED, SEVERAL_ROBOTS
+from stage_sim.sim import body_kernels, fused_kernels, motion_kernels, ranger_kernels
+from stage_sim.sim.collision import CollisionChecker, Contact
 from stage_sim.sim.drives import DriveGroup
+from stage_sim.sim.ray_groups import SingleCast
 
 # Items (points, probes, robot pairs, rays) from which a compiled loop is shared among threads.
 PARALLEL_ITEMS = 4096
@@ -62,7 +64,7 @@ class CompiledCollisionChecker(CollisionChecker):
                 poses: tuple, refused: np.ndarray) -> None:
         candidates, layer_poses, start_poses = poses
         box = np.stack([self._boxes(p) for p in (layer_poses, candidates, start_poses)])
-        body_kernels.move_one_by_one(testers, static_hit, *cand, *before, *back, self._colliding, box, refused)
+        body_kernels.move_one_by_one(testers, static_hit, *cand, *before, *back, self.colliding, box, refused)
 
     def _boxes(self, poses: np.ndarray) -> np.ndarray:
         """(col min, row min, col max, row max) world cells holding each robot's raster at ``poses``: its
@@ -112,3 +114,95 @@ def hit_intensity(cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, r
     several = float(robot_return.max(initial=0.0))
     kernel(ranger_kernels, "hit_intensity", cell.size, threads)(
         cell, hit_robot, static.cells, static.values, robot_return, robots_seen, SEVERAL_ROBOTS, several, rays, out)
+
+
+class FusedStep:
+    """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
+    moves, contacts and odometry, then every ray; the numpy calls left are the trigonometry's and the new
+    arrays'. For worlds whose robots share one height band and whose rays one height, without noise and on
+    one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by role."""
+
+    def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast) -> None:
+        bodies, grid = collision.bodies, collision.grid
+        layer = collision.static_layer()
+        self._collision = collision
+        self._cast = cast
+        self._bodies = (bodies.vertices, bodies.poly_start, bodies.robot_poly)
+        self._radius = bodies.radius
+        self._grid = np.array([*grid.corner, *grid.shape], dtype=np.int64)
+        self._ppm = 1.0 / grid.resolution
+        self._static = (layer.grid.slots, layer.tile_of_slot, layer.bits, layer.grid.place)
+        group = cast.group
+        self._robots = group.robots
+        self._region_place = group.robots.grid.place
+        self._walk = group.caster.walk_arguments(cast.longest)
+        self._robots_seen = bodies.count > 1  # a lone robot never sees itself
+        self._several_return = float(group.robot_return.max(initial=0.0))
+        beams = group.rays.size
+        self._ranges = np.empty(beams)
+        self._cell = np.empty(beams, dtype=np.int64)
+        self._hit_robot = np.empty(beams, dtype=np.int32)
+        self._integrated = np.empty((bodies.count, 3))
+
+    @classmethod
+    def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
+        """The fused step of a world's compiled contacts and rays (None: not all at one height, or noisy), or None
+        when it steps role by role: robots in several height bands, or more than one thread with more rays than
+        a cast keeps on one (the parallel loops)."""
+        if (cast is None or not isinstance(collision, CompiledCollisionChecker) or collision.static_layer() is None
+                or (threads > 1 and cast.group.rays.size > PARALLEL_RAYS)):
+            return None
+        return cls(collision, cast)
+
+    def step(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """One step from ``poses`` in the layer at ``layer_poses`` with ``velocities``, every ray cast: (new poses,
+        stall flags, odometry, layer poses, float32 ranges and intensities of every beam), new arrays."""
+        n = poses.shape[0]
+        start_trig = _trig(poses)
+        motion_kernels.integrate_poses(poses, velocities, dt, start_trig[0], start_trig[1], self._integrated)
+        final, layer_out, odometry = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+        stalled_out = np.empty(n, dtype=bool)
+        final_trig = np.empty((2, n))
+        collision = self._collision
+        cells, cell_robot = fused_kernels.move(
+            poses, self._integrated, layer_poses, velocities, stalled, estimates, errors, dt, uses_odom, start_trig,
+            _trig(self._integrated), _trig(layer_poses), _trig(estimates), self._bodies, self._radius, self._grid,
+            self._ppm, collision.collides, collision.colliding, collision.robots_can_clash, self._static, final,
+            stalled_out, layer_out, odometry, final_trig)
+        published, intensity = self._sense(final, final_trig, cells, cell_robot)
+        return final, stalled_out, odometry, layer_out, published, intensity
+
+    def _sense(self, poses: np.ndarray, trig: np.ndarray, cells: np.ndarray, cell_robot: np.ndarray,
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Every ray cast from ``poses`` (cos and sin ``trig``) with the robots' raster (``cells``, ``cell_robot``):
+        (float32 ranges, intensities)."""
+        cast, robots = self._cast, self._robots
+        group = cast.group
+        published = np.empty(group.rays.size, dtype=np.float32)
+        intensity = np.empty(group.rays.size, dtype=np.float32)
+        world, place, stops, pad, ppm = self._walk
+        while True:
+            layer = (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
+                     robots.owner)
+            marked, count, active = fused_kernels.sense(
+                poses, trig, cast.ranger_offset, cast.ranger_owner, cells, cell_robot, self._robots_seen,
+                group.robot_visible, layer, robots.marked, robots.active, robots.capacity, self._region_place,
+                robots.shape[1], MARKED, SEVERAL_ROBOTS, world, place, stops, pad, group.ranger, group.angle,
+                group.max_range, group.owner, group.rays, cast.no_jitter, cast.trig, ppm, group.intensity.cells,
+                group.intensity.values, group.robot_return, self._several_return, self._ranges, self._cell,
+                self._hit_robot, published, intensity)
+            robots.took(marked, active)
+            if count <= robots.capacity:
+                return published, intensity
+            robots.reserve(count)
+
+
+def _trig(poses: np.ndarray) -> np.ndarray:
+    """(2, N): numpy's cos and sin of the headings ``poses[:, 2]``, the calls the role-by-role kernels make."""
+    heading = poses[:, 2]
+    trig = np.empty((2, heading.size))
+    np.cos(heading, out=trig[0])
+    np.sin(heading, out=trig[1])
+    return trig

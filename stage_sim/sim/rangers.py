@@ -12,17 +12,16 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
-from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import RayCaster
-from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sim.collision import Bodies, GridFrame
+from stage_sim.sim.ray_groups import HeightGroup, SingleCast
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
@@ -36,22 +35,6 @@ class Scan:
     ranges: np.ndarray
     intensities: np.ndarray
     stamp: float
-
-
-@dataclass(frozen=True)
-class _HeightGroup:
-    """The rays cast at one height, with the static layer and the robots visible there."""
-
-    rays: np.ndarray
-    owner: np.ndarray  #: per ray of the group: its robot, ranger, angle in the robot frame and range
-    ranger: np.ndarray
-    angle: np.ndarray
-    max_range: np.ndarray
-    caster: RayCaster
-    robots: RobotLayer
-    intensity: CellValues
-    robot_visible: np.ndarray
-    robot_return: np.ndarray
 
 
 class RangerSensing:
@@ -130,13 +113,11 @@ class RangerSensing:
         ``body_cells``: the robots' raster the rays see, (cell, robot)
         (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
-        all_due = self._stale or now_us >= self._all_due_us
-        self._stale = False
-        if all_due:
+        if self.all_due(time):
             due = None
-            self._last_us[:] = now_us
-            self._all_due_us = now_us + self._longest_us
+            self._mark_all_cast(now_us)
         else:
+            self._stale = False
             due = (now_us - self._last_us) >= self._interval_us
             if not due.any():
                 return
@@ -158,7 +139,35 @@ class RangerSensing:
         noisy = self._apply_noise(ranges, self._every_ray if ray_due is None else ray_due) \
             if self._noisy else ranges
         published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
-        for k in (range(len(self._rangers)) if due is None else np.flatnonzero(due)):
+        self._publish(range(len(self._rangers)) if due is None else np.flatnonzero(due), published, intensity, time)
+
+    def all_due(self, time: float) -> bool:
+        """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
+        return self._stale or round(time * 1e6) >= self._all_due_us
+
+    def single_cast(self) -> SingleCast | None:
+        """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
+        it can: all rays at one height, no noise, seen robots; else None (:meth:`sense` casts them)."""
+        if len(self._groups) != 1 or self._noisy or not self._bodies.count:
+            return None
+        return SingleCast(self._groups[0], self._ranger_offset, self._ranger_owner, self._trig, self._no_jitter,
+                          float(self._max_range.max(initial=0.0)))
+
+    def record_all(self, published: np.ndarray, intensity: np.ndarray, time: float) -> None:
+        """Take the scans of every ranger cast at ``time`` by a fused step (when :meth:`all_due`): what
+        :meth:`sense` keeps of its own cast."""
+        self._mark_all_cast(round(time * 1e6))
+        self._publish(range(len(self._rangers)), published, intensity, time)
+
+    def _mark_all_cast(self, now_us: int) -> None:
+        """Every ranger cast at ``now_us``: the next all-due step is a longest interval away."""
+        self._stale = False
+        self._last_us[:] = now_us
+        self._all_due_us = now_us + self._longest_us
+
+    def _publish(self, rangers: Iterable[int], published: np.ndarray, intensity: np.ndarray, time: float) -> None:
+        """New scans of ``rangers`` from the float32 ranges and intensities of all beams (views of their own)."""
+        for k in rangers:
             robot_index, ranger_index, part = self._scan_slots[k]
             scan = Scan(published[part], intensity[part], time)
             robot_scans = self.latest[robot_index]
@@ -168,7 +177,7 @@ class RangerSensing:
                 robot_scans.append(scan)
 
     def _cast(
-        self, group: _HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
+        self, group: HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
         jitter: np.ndarray | None, robot_cells: tuple[np.ndarray, np.ndarray] | None, ranges: np.ndarray,
         intensity: np.ndarray,
     ) -> None:
@@ -230,7 +239,7 @@ class RangerSensing:
                                                              threads=self._grid.threads)
             caster = casters[id(occupied)]
             rays = np.flatnonzero(ray_height == height)
-            groups.append(_HeightGroup(
+            groups.append(HeightGroup(
                 rays=rays,
                 owner=self._owner[rays],
                 ranger=self._ranger_of_ray[rays],

@@ -44,7 +44,7 @@ TEN_POSES = ["20.900 4.700 0 -85.8", "25.100 18.500 0 -72.5", "15.500 4.100 0 11
              "25.700 14.900 0 36.0", "19.100 16.700 0 82.3", "10.100 13.100 0 -112.4", "17.300 16.100 0 -160.1",
              "22.700 16.100 0 -81.0", "21.500 6.500 0 56.7"]
 
-# Two robots with a fast front laser and a slow, noisy back one; interval_sim 50 ms, so that the front one
+# Three robots with a fast front laser and a slow, noisy back one; interval_sim 50 ms, so that the front one
 # scans every second step and the back one every third.
 TWO_RANGERS = """
 resolution 0.02
@@ -121,6 +121,12 @@ def crowd(seed: int) -> str:
     return crowd_world(seed)
 
 
+def quiet_crowd(seed: int) -> str:
+    """The crowd without noise and without its low robots: every robot in one height band, every ray at one
+    height (a world the fused step takes)."""
+    return crowd(seed).replace(" noise [0.0004 0.01 0.5]", "").replace(" size [0.4 0.3 0.05]", "")
+
+
 @dataclass(frozen=True)
 class Case:
     """A recorded run: its world, the simulation's options, its commands and its steps per kernels (fewer on
@@ -139,7 +145,10 @@ CASES = {
                        {"numba": 300, "numpy": 30}),
     "one_robot_random": Case(lambda: ROOMS + ONE, lambda: random_commands(3), {"numba": 300, "numpy": 60}),
     "noisy_crowd": Case(lambda: crowd(0), lambda: random_commands(0), {"numba": 150, "numpy": 40}),
+    "quiet_crowd": Case(lambda: quiet_crowd(1), lambda: random_commands(1), {"numba": 150, "numpy": 40}),
     "two_rangers": Case(lambda: TWO_RANGERS, interrupted, {"numba": 300, "numpy": 300}, {"watchdog_timeout": 0.3}),
+    "two_quiet_rangers": Case(lambda: TWO_RANGERS.replace(" noise [0.0004 0.02 0.8]", ""), interrupted,
+                              {"numba": 300, "numpy": 120}, {"watchdog_timeout": 0.3}),
     "lone_noisy": Case(lambda: LONE, lambda: random_commands(7, (-0.5, -0.5, -2.0), (1.0, 0.5, 2.0)),
                        {"numba": 300, "numpy": 150}),
 }
