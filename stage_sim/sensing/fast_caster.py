@@ -92,9 +92,7 @@ class NumbaRayCaster:
         reuses for beams whose angle did not change. Returns (hit cell, hit robot) per ray. Arrays: int64
         indices, float64 values, C-contiguous."""
         n = owners.size
-        layer = (self._no_robots if robots is None else
-                 (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
-                  robots.owner))
+        layer = self._no_robots if robots is None else robots.tables
         flags = (robots is not None, robots is not None and robots.active)
         marked = _NO_REGIONS if robots is None else robots.marked
         stops, pad = self._stops.fitted(float(rmax.max(initial=0.0)) / self.resolution)

@@ -218,6 +218,11 @@ class CompiledRobotLayer(RobotLayer):
                                                       self.owner, tile, local, ids.astype(np.int32), count,
                                                       SEVERAL_ROBOTS)
 
+    @property
+    def tables(self) -> tuple[np.ndarray, ...]:
+        """What the compiled walk reads: (regions, ids, row masks, column masks, used rows, used columns, owner)."""
+        return self.regions, self.ids, self.rows, self.cols, self.rows_used, self.cols_used, self.owner
+
     def _grow(self, capacity: int) -> None:
         self.rows = np.empty((capacity, TILE), dtype=np.uint32)
         self.cols = np.empty((capacity, TILE), dtype=np.uint32)

@@ -75,10 +75,10 @@ class Motion(Protocol):
 class Fused(Protocol):
     """A whole step in few calls, as the roles give it step by step (:meth:`~stage_sim.sim.compiled.FusedStep.step`)."""
 
-    def step(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray,
+    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(new poses, stall flags, odometry, layer poses, float32 ranges and intensities of every beam)."""
+        """(new poses, stall flags, odometry, both layers' poses, float32 ranges and intensities of every beam)."""
         ...
 
 

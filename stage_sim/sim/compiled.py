@@ -23,6 +23,8 @@ from stage_sim.sim.collision import CollisionChecker, Contact
 from stage_sim.sim.drives import DriveGroup
 from stage_sim.sim.ray_groups import SingleCast
 
+#: The steering cos and sin given to drives that read none (``Drive.steered``).
+_UNSTEERED = np.zeros(0)
 # Items (points, probes, robot pairs, rays) from which a compiled loop is shared among threads.
 PARALLEL_ITEMS = 4096
 
@@ -83,9 +85,13 @@ class CompiledMotion:
     @staticmethod
     def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
                         ) -> np.ndarray:
-        steer = commands[:, 2]
         out = np.empty_like(commands)
-        motion_kernels.body_velocities(commands, drives, wheelbases, bounds, np.cos(steer), np.sin(steer), out)
+        if any(group.drive.steered for group in drives):
+            steer = commands[:, 2]
+            cos_steer, sin_steer = np.cos(steer), np.sin(steer)
+        else:
+            cos_steer = sin_steer = _UNSTEERED
+        motion_kernels.body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out)
         return out
 
     @staticmethod
@@ -118,31 +124,49 @@ def hit_intensity(cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, r
 
 class FusedStep:
     """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
-    moves, contacts and odometry, then every ray; the numpy calls left are the trigonometry's and the new
-    arrays'. For worlds whose robots share one height band and whose rays one height, without noise and on
-    one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by role."""
+    end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin
+    and the new arrays. For worlds whose robots share one height band and whose rays one height, without noise
+    and on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by role."""
 
     def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast) -> None:
         bodies, grid = collision.bodies, collision.grid
-        layer = collision.static_layer()
-        self._collision = collision
-        self._cast = cast
-        self._bodies = (bodies.vertices, bodies.poly_start, bodies.robot_poly)
-        self._radius = bodies.radius
-        self._grid = np.array([*grid.corner, *grid.shape], dtype=np.int64)
-        self._ppm = 1.0 / grid.resolution
-        self._static = (layer.grid.slots, layer.tile_of_slot, layer.bits, layer.grid.place)
+        static = collision.static_layer()
         group = cast.group
+        n, beams = bodies.count, group.rays.size
+        world, place, stops, pad, walk_ppm = group.caster.walk_arguments(cast.longest)
         self._robots = group.robots
-        self._region_place = group.robots.grid.place
-        self._walk = group.caster.walk_arguments(cast.longest)
-        self._robots_seen = bodies.count > 1  # a lone robot never sees itself
-        self._several_return = float(group.robot_return.max(initial=0.0))
-        beams = group.rays.size
-        self._ranges = np.empty(beams)
-        self._cell = np.empty(beams, dtype=np.int64)
-        self._hit_robot = np.empty(beams, dtype=np.int32)
-        self._integrated = np.empty((bodies.count, 3))
+        self._fields = {
+            "vertices": bodies.vertices, "poly_start": bodies.poly_start, "robot_poly": bodies.robot_poly,
+            "radius": bodies.radius, "grid": np.array([*grid.corner, *grid.shape, static.grid.shape[1]]),
+            "ppm": 1.0 / grid.resolution, "collides": collision.collides, "colliding": collision.colliding,
+            "can_clash": collision.robots_can_clash, "slots": static.grid.slots, "tile_of_slot": static.tile_of_slot,
+            "bits": static.bits, "static_place": static.grid.place, "ranger_offset": cast.ranger_offset,
+            "ranger_owner": cast.ranger_owner, "robots_seen": n > 1,  # a lone robot never sees itself
+            "visible": group.robot_visible, "region_place": group.robots.grid.place, "width": group.robots.shape[1],
+            "marked_value": MARKED, "several": SEVERAL_ROBOTS, "walk_place": place, "stops": stops, "pad": pad,
+            "walk_ppm": walk_ppm, "ranger": group.ranger, "angle": group.angle, "rmax": group.max_range,
+            "owner": group.owner, "rays": group.rays, "jitter": cast.no_jitter, "static_cells": group.intensity.cells,
+            "static_values": group.intensity.values, "robot_return": group.robot_return,
+            "several_return": float(group.robot_return.max(initial=0.0)), "ranges": np.empty(beams),
+            "cell": np.empty(beams, dtype=np.int64), "hit_robot": np.empty(beams, dtype=np.int32),
+            "headings": np.zeros((2 * n, 3)),  # column 2: a step's new headings (end poses, then odometry) ...
+            "known": np.full((4, n), np.nan),  # ... the headings of the poses, odometry, layers 0 and 1 ...
+            "known_trig": np.empty((4, 2, n)),  # ... and their numpy cos and sin
+            **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
+                       world, strict=True)),
+            **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
+        }
+        self._pack()
+
+    def _pack(self) -> None:
+        """The fields in one argument, with the robot layer's tables as they stand (they grow, rarely; the
+        sensing's own casts may grow them too)."""
+        robots = self._robots
+        self._ids = robots.ids
+        tables = dict(zip(("regions", "ids", "rows", "cols", "rows_used", "cols_used", "tile_owner"), robots.tables,
+                          strict=True))
+        fields = {**self._fields, **tables, "capacity": robots.capacity}
+        self._world = fused_kernels.fused_world(*(fields[name] for name in fused_kernels.FIELDS))
 
     @classmethod
     def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
@@ -154,49 +178,44 @@ class FusedStep:
             return None
         return cls(collision, cast)
 
-    def step(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray,
+    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """One step from ``poses`` in the layer at ``layer_poses`` with ``velocities``, every ray cast: (new poses,
-        stall flags, odometry, layer poses, float32 ranges and intensities of every beam), new arrays."""
-        n = poses.shape[0]
-        start_trig = _trig(poses)
-        motion_kernels.integrate_poses(poses, velocities, dt, start_trig[0], start_trig[1], self._integrated)
-        final, layer_out, odometry = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
-        stalled_out = np.empty(n, dtype=bool)
-        final_trig = np.empty((2, n))
-        collision = self._collision
-        cells, cell_robot = fused_kernels.move(
-            poses, self._integrated, layer_poses, velocities, stalled, estimates, errors, dt, uses_odom, start_trig,
-            _trig(self._integrated), _trig(layer_poses), _trig(estimates), self._bodies, self._radius, self._grid,
-            self._ppm, collision.collides, collision.colliding, collision.robots_can_clash, self._static, final,
-            stalled_out, layer_out, odometry, final_trig)
-        published, intensity = self._sense(final, final_trig, cells, cell_robot)
-        return final, stalled_out, odometry, layer_out, published, intensity
-
-    def _sense(self, poses: np.ndarray, trig: np.ndarray, cells: np.ndarray, cell_robot: np.ndarray,
-               ) -> tuple[np.ndarray, np.ndarray]:
-        """Every ray cast from ``poses`` (cos and sin ``trig``) with the robots' raster (``cells``, ``cell_robot``):
-        (float32 ranges, intensities)."""
-        cast, robots = self._cast, self._robots
-        group = cast.group
-        published = np.empty(group.rays.size, dtype=np.float32)
-        intensity = np.empty(group.rays.size, dtype=np.float32)
-        world, place, stops, pad, ppm = self._walk
-        while True:
-            layer = (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
-                     robots.owner)
-            marked, count, active = fused_kernels.sense(
-                poses, trig, cast.ranger_offset, cast.ranger_owner, cells, cell_robot, self._robots_seen,
-                group.robot_visible, layer, robots.marked, robots.active, robots.capacity, self._region_place,
-                robots.shape[1], MARKED, SEVERAL_ROBOTS, world, place, stops, pad, group.ranger, group.angle,
-                group.max_range, group.owner, group.rays, cast.no_jitter, cast.trig, ppm, group.intensity.cells,
-                group.intensity.values, group.robot_return, self._several_return, self._ranges, self._cell,
-                self._hit_robot, published, intensity)
+        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``, every ray cast:
+        (new poses, stall flags, odometry, layers, float32 ranges and intensities of every beam), new arrays."""
+        robots = self._robots
+        if robots.ids is not self._ids:
+            self._pack()
+        n, world = poses.shape[0], self._world
+        integrated, odometry = np.empty((n, 3)), np.empty((n, 3))
+        if not fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, True,
+                                     integrated, odometry):
+            self._learn(poses, layers, layer, estimates)
+            fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, False,
+                                  integrated, odometry)
+        final, stalled_out, final_trig = np.empty((n, 3)), np.empty(n, dtype=bool), np.empty((2, n))
+        layers = layers.copy()
+        beams = self._fields["rays"].size
+        published, intensity = np.empty(beams, dtype=np.float32), np.empty(beams, dtype=np.float32)
+        cells, cell_robot, marked, tiles, active = fused_kernels.step(
+            world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom,
+            _trig(self._fields["headings"]), final, stalled_out, final_trig, robots.marked, robots.active, published,
+            intensity)
+        robots.took(marked, active)
+        while tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast again
+            robots.reserve(tiles)
+            self._pack()
+            marked, tiles, active = fused_kernels.sense(self._world, final, final_trig, cells, cell_robot,
+                                                        robots.marked, robots.active, published, intensity)
             robots.took(marked, active)
-            if count <= robots.capacity:
-                return published, intensity
-            robots.reserve(count)
+        return final, stalled_out, odometry, layers, published, intensity
+
+    def _learn(self, poses: np.ndarray, layers: np.ndarray, layer: int, estimates: np.ndarray) -> None:
+        """Compute the cos and sin of the start headings anew (the first step, or poses set between steps)."""
+        known, known_trig = self._fields["known"], self._fields["known_trig"]
+        for row, source in ((0, poses), (1, estimates), (2 + layer, layers[layer])):
+            known[row] = source[:, 2]
+            known_trig[row] = _trig(source)
 
 
 def _trig(poses: np.ndarray) -> np.ndarray:

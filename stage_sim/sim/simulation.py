@@ -212,9 +212,8 @@ class Simulation:
         self.velocities = self._body_velocities()
         layer = self._updates % 2
         if self._fused is not None and self._sensing.all_due(self.sim_time):
-            self._layer_poses = self._layer_poses.copy()
-            self.true_poses, self.stalled, self.odometry_poses, self._layer_poses[layer], ranges, intensities = \
-                self._fused.step(self.true_poses, self._layer_poses[layer], self.velocities, self.stalled,
+            self.true_poses, self.stalled, self.odometry_poses, self._layer_poses, ranges, intensities = \
+                self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
                                  self.odometry_poses, self.odom_errors, self._uses_odom, dt)
             self._updates += 1
             self._sensing.record_all(ranges, intensities, self.sim_time)
