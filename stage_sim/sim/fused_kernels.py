@@ -148,8 +148,8 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
     without ``uses_odom``, and what ``world.known`` and ``world.known_trig`` hold for the next step
     (:func:`advance`). Returns :func:`sense`'s answer."""
     n = poses.shape[0]
-    known, known_trig = world.known, world.known_trig
-    layer_poses = layers[layer].copy()
+    known, known_trig, collides = world.known, world.known_trig, world.collides  # locals: each read of a field
+    layer_poses = layers[layer].copy()  # counts a reference
     moving = np.zeros(n, dtype=np.bool_)
     candidates = poses.copy()
     testers = np.empty(n, dtype=np.int64)
@@ -158,7 +158,7 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
         moving[i] = velocities[i, 0] != 0.0 or velocities[i, 1] != 0.0 or velocities[i, 2] != 0.0
         if moving[i]:
             candidates[i] = integrated[i]
-            if world.collides[i]:
+            if collides[i]:
                 testers[count] = i
                 count += 1
     testers = testers[:count]
@@ -237,16 +237,17 @@ def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, 
             w.regions, old_marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=np.bool_),
             w.region_place, w.width, w.marked_value)[0]
         count = 0
-    heading = np.empty(w.ranger_owner.size)
-    for k in range(w.ranger_owner.size):
-        heading[k] = poses[w.ranger_owner[k], 2]
+    ranger_owner, ranges = w.ranger_owner, w.ranges  # locals: each read of a field counts a reference
+    heading = np.empty(ranger_owner.size)
+    for k in range(ranger_owner.size):
+        heading[k] = poses[ranger_owner[k], 2]
     traversal.cast_serial(
         (w.walk_rows, w.walk_cols, w.walk_tiles, w.walk_slots, w.walk_rows_used, w.walk_cols_used),
         (w.regions, w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner), (True, active), w.walk_place,
         w.stops, w.pad, marked, origins, w.ranger, heading, w.angle, w.jitter, (w.last_angle, w.last_cos, w.last_sin),
-        w.rmax, w.walk_ppm, w.owner, w.rays, w.ranges, w.cell, w.hit_robot)
+        w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
     ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
                                  w.several, w.several_return, w.rays, intensity)
-    for i in range(w.ranges.size):
-        published[i] = np.float32(w.ranges[i])
+    for i in range(ranges.size):
+        published[i] = np.float32(ranges[i])
     return marked, count, active
