@@ -156,6 +156,10 @@ class FusedStep:
                        world, strict=True)),
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
         }
+        self._beams = beams
+        self._new_headings = self._fields["headings"][:, 2]  # numpy's cos and sin of a strided column, as the roles'
+        self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))  # end poses, cos and sin of the
+        # new headings and of the new poses
         self._pack()
 
     def _pack(self) -> None:
@@ -186,21 +190,20 @@ class FusedStep:
         robots = self._robots
         if robots.ids is not self._ids:
             self._pack()
-        n, world = poses.shape[0], self._world
-        integrated, odometry = np.empty((n, 3)), np.empty((n, 3))
+        n, world, integrated, end_trig, final_trig = poses.shape[0], self._world, *self._scratch
+        odometry = np.empty((n, 3))
         if not fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, True,
                                      integrated, odometry):
             self._learn(poses, layers, layer, estimates)
             fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, False,
                                   integrated, odometry)
-        final, stalled_out, final_trig = np.empty((n, 3)), np.empty(n, dtype=bool), np.empty((2, n))
-        layers = layers.copy()
-        beams = self._fields["rays"].size
-        published, intensity = np.empty(beams, dtype=np.float32), np.empty(beams, dtype=np.float32)
+        np.cos(self._new_headings, out=end_trig[0])
+        np.sin(self._new_headings, out=end_trig[1])
+        final, stalled_out, layers = np.empty((n, 3)), np.empty(n, dtype=bool), layers.copy()
+        published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
         cells, cell_robot, marked, tiles, active = fused_kernels.step(
-            world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom,
-            _trig(self._fields["headings"]), final, stalled_out, final_trig, robots.marked, robots.active, published,
-            intensity)
+            world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
+            stalled_out, final_trig, robots.marked, robots.active, published, intensity)
         robots.took(marked, active)
         while tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast again
             robots.reserve(tiles)

@@ -166,6 +166,7 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
     start_cos, start_sin = known_trig[0, 0].copy(), known_trig[0, 1].copy()
     end_cos, end_sin = end_trig[0, :n].copy(), end_trig[1, :n].copy()
     row = 2 + layer
+    end_cells, end_robot = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
     if count:
         end_cells, end_robot = _raster(world, testers, candidates, end_cos, end_sin)
         static_hit = np.zeros(n, dtype=np.bool_)
@@ -204,7 +205,10 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
                 odometry[i, axis] = final[i, axis]
             known_trig[1, 0, i], known_trig[1, 1, i] = final_trig[0, i], final_trig[1, i]
         known[1, i] = odometry[i, 2]
-    cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
+    if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
+        cells, cell_robot = end_cells, end_robot
+    else:
+        cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
     marked, tiles, active = sense(world, final, final_trig, cells, cell_robot, old_marked, active, published,
                                   intensity)
     return cells, cell_robot, marked, tiles, active
