@@ -10,7 +10,7 @@ from stage_sim.sensing.casters import RayCaster
 from stage_sim.sensing.fast_caster import NumbaRayCaster
 from stage_sim.sensing.raycast import GridRayCaster
 from stage_sim.sim import compiled, returns
-from stage_sim.sim.backends import Backend, Motion, ReferenceMotion, backend_for
+from stage_sim.sim.backends import Backend, Motion, ReferenceMotion, backend_for, no_fused_step
 from stage_sim.sim.collision import CollisionChecker, Contact
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
@@ -34,6 +34,7 @@ def test_the_chooser_maps_each_name_to_its_implementations():
     assert (numpy.contact, numba.contact) == (CollisionChecker, compiled.CompiledCollisionChecker)
     assert isinstance(numpy.motion, ReferenceMotion) and isinstance(numba.motion, compiled.CompiledMotion)
     assert (numpy.hit_intensity, numba.hit_intensity) == (returns.hit_intensity, compiled.hit_intensity)
+    assert (numpy.fused, numba.fused) == (no_fused_step, compiled.FusedStep.of)
     assert isinstance(numpy.caster(np.zeros((4, 4), dtype=bool), 0.1, (0.0, 0.0)), GridRayCaster)
     assert isinstance(numba.caster(np.zeros((4, 4), dtype=bool), 0.1, (0.0, 0.0)), NumbaRayCaster)
     assert backend_for("numba") is numba  # built once
@@ -62,3 +63,39 @@ def test_a_simulation_runs_on_the_parts_its_kernels_name(kernels):
     sim.set_velocity(0, 0.3, 0.0, 0.2)
     sim.step()
     assert sim.scans[0][0].ranges.shape == (9,)
+
+
+def _frames(sim: Simulation, steps: int, seed: int) -> list[tuple]:
+    """Every step's state under random commands, a reset and a pose set on the way."""
+    commands = np.random.default_rng(seed).uniform([-0.4, -0.4, -1.5], [0.8, 0.4, 1.5], (steps, len(sim.robots), 3))
+    frames = []
+    for step in range(steps):
+        sim.set_velocities(np.arange(len(sim.robots)), commands[step])
+        if step == steps // 3:
+            sim.reset_positions()
+        if step == steps // 2:
+            sim.set_pose(0, *sim.start_poses[1])  # onto another robot: both stall until one backs away
+        sim.step()
+        scans = [(s.ranges.tobytes(), s.intensities.tobytes(), s.stamp) for robot in sim.scans for s in robot]
+        frames.append((sim.true_poses.tobytes(), sim.odometry_poses.tobytes(), sim.stalled.tobytes(), scans))
+    return frames
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_the_fused_step_gives_the_role_by_role_answers(threads):
+    from tests.sim.test_step_digests import quiet_crowd
+
+    world = load_world_text(quiet_crowd(2).replace("samples 271", "samples 41"), "crowd.world")  # few enough rays
+    # for one thread's cast
+    fused = Simulation(world, seed=4, kernels="numba", threads=threads)
+    by_roles = Simulation(world, seed=4, kernels="numba", threads=threads)
+    by_roles._fused = None
+    assert fused._fused is not None
+    assert _frames(fused, 30, 4) == _frames(by_roles, 30, 4)
+
+
+def test_noise_and_several_heights_step_role_by_role():
+    from tests.sim.test_step_digests import crowd
+
+    assert Simulation(load_world_text(crowd(0), "crowd.world"), seed=0, kernels="numba")._fused is None
+    assert Simulation(load_world_text(WORLD, "two.world"), seed=0, kernels="numba")._fused is not None
