@@ -86,11 +86,11 @@ class CompiledMotion:
     def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
                         ) -> np.ndarray:
         out = np.empty_like(commands)
-        if any(group.drive.steered for group in drives):
-            steer = commands[:, 2]
-            cos_steer, sin_steer = np.cos(steer), np.sin(steer)
-        else:
-            cos_steer = sin_steer = _UNSTEERED
+        cos_steer = sin_steer = _UNSTEERED
+        for group in drives:
+            if group.drive.steered:
+                steer = commands[:, 2]
+                cos_steer, sin_steer = np.cos(steer), np.sin(steer)
         motion_kernels.body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out)
         return out
 
@@ -157,6 +157,7 @@ class FusedStep:
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
         }
         self._beams = beams
+        self._known = self._fields["known"], self._fields["known_trig"], self._fields["headings"]
         self._new_headings = self._fields["headings"][:, 2]  # numpy's cos and sin of a strided column, as the roles'
         self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))  # end poses, cos and sin of the
         # new headings and of the new poses
@@ -192,11 +193,12 @@ class FusedStep:
             self._pack()
         n, world, integrated, end_trig, final_trig = poses.shape[0], self._world, *self._scratch
         odometry = np.empty((n, 3))
-        if not fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, True,
-                                     integrated, odometry):
+        known, known_trig, headings = self._known
+        if not fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
+                                     known_trig, True, integrated, odometry, headings):
             self._learn(poses, layers, layer, estimates)
-            fused_kernels.advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, False,
-                                  integrated, odometry)
+            fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
+                                  known_trig, False, integrated, odometry, headings)
         np.cos(self._new_headings, out=end_trig[0])
         np.sin(self._new_headings, out=end_trig[1])
         final, stalled_out, layers = np.empty((n, 3)), np.empty(n, dtype=bool), layers.copy()

@@ -108,17 +108,18 @@ def _same(a, b):
 
 
 @numba.njit(**_JIT)
-def advance(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, check, integrated, odometry):
+def advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known, known_trig, check, integrated,
+            odometry, headings):
     """The end poses of every robot (:func:`~stage_sim.sim.motion_kernels.integrate_poses`) into ``integrated``
     and the odometry of the robots that ``uses_odom`` (:func:`~stage_sim.sim.motion_kernels.integrate_estimates`)
     into ``odometry``, with the cos and sin of their start headings remembered from the last step; their new
-    headings into ``world.headings[:, 2]`` (end poses, then odometry), whose cos and sin the step needs next.
+    headings into ``headings[:, 2]`` (end poses, then odometry), whose cos and sin the step needs next.
 
-    ``world.known`` (4, N): the headings whose numpy cos and sin ``world.known_trig`` (4, 2, N) holds, of the
-    poses, the odometry and layers 0 and 1. With ``check``, returns False (and does nothing) unless they are the
-    headings of ``poses``, ``estimates`` and ``layers[layer]`` bit for bit (a reset or a pose set between steps)."""
+    ``known`` (4, N): the headings whose numpy cos and sin ``known_trig`` (4, 2, N) holds, of the poses, the
+    odometry and layers 0 and 1 (a :class:`FusedWorld`'s, given apart: fewer arguments to check than the world).
+    With ``check``, returns False (and does nothing) unless they are the headings of ``poses``, ``estimates``
+    and ``layers[layer]`` bit for bit (a reset or a pose set between steps)."""
     n = poses.shape[0]
-    known, known_trig, headings = world.known, world.known_trig, world.headings
     if check:
         for i in range(n):
             if not (_same(poses[i, 2], known[0, i]) and _same(estimates[i, 2], known[1, i])
