@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache, partial
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import integrate_odometry
 from stage_sim.sim.ray_groups import SingleCast
 from stage_sim.sim.returns import hit_intensity
+
+if TYPE_CHECKING:
+    from stage_sim.sim.compiled import FusedResult
 
 
 class CasterFactory(Protocol):
@@ -77,8 +80,8 @@ class Fused(Protocol):
 
     def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(new poses, stall flags, odometry, both layers' poses, float32 ranges and intensities of every beam)."""
+             ) -> FusedResult:
+        """One step: :class:`~stage_sim.sim.compiled.FusedResult`."""
         ...
 
 

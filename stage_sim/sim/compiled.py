@@ -10,6 +10,7 @@ twin, on the grid's threads, from :data:`PARALLEL_ITEMS` items on.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from types import ModuleType
 
 import numpy as np
@@ -122,6 +123,20 @@ def hit_intensity(cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, r
         cell, hit_robot, static.cells, static.values, robot_return, robots_seen, SEVERAL_ROBOTS, several, rays, out)
 
 
+@dataclass(frozen=True)
+class FusedResult:
+    """A fused step's new state (new arrays) and scans."""
+
+    poses: np.ndarray
+    stalled: np.ndarray
+    odometry: np.ndarray
+    layers: np.ndarray  #: (2, N, 3) the robots' poses in each of Stage's layers
+    scans: tuple[np.ndarray, np.ndarray] | None
+    """float32 ranges and intensities of every beam; None when the robot layer had no room for the robots' tiles:
+    the sensing casts the rays then (and grows it)."""
+    raster: tuple[np.ndarray, np.ndarray]  #: (cell, robot) of the robots' cells the rays see
+
+
 class FusedStep:
     """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
     end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin
@@ -185,9 +200,8 @@ class FusedStep:
 
     def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``, every ray cast:
-        (new poses, stall flags, odometry, layers, float32 ranges and intensities of every beam), new arrays."""
+             ) -> FusedResult:
+        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``, every ray cast."""
         robots = self._robots
         if robots.ids is not self._ids:
             self._pack()
@@ -207,13 +221,8 @@ class FusedStep:
             world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
             stalled_out, final_trig, robots.marked, robots.active, published, intensity)
         robots.took(marked, active)
-        while tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast again
-            robots.reserve(tiles)
-            self._pack()
-            marked, tiles, active = fused_kernels.sense(self._world, final, final_trig, cells, cell_robot,
-                                                        robots.marked, robots.active, published, intensity)
-            robots.took(marked, active)
-        return final, stalled_out, odometry, layers, published, intensity
+        scans = None if tiles > robots.capacity else (published, intensity)  # else the robot layer must grow
+        return FusedResult(final, stalled_out, odometry, layers, scans, (cells, cell_robot))
 
     def _learn(self, poses: np.ndarray, layers: np.ndarray, layer: int, estimates: np.ndarray) -> None:
         """Compute the cos and sin of the start headings anew (the first step, or poses set between steps)."""

@@ -226,7 +226,7 @@ def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, 
     With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
     layer's tiles, else their regions are only marked. Returns (regions marked, tiles needed, whether the
     layer holds a cell); when the layer has room for fewer tiles than needed (``world.capacity``) nothing is
-    cast: the caller grows it and calls again."""
+    cast: the caller casts the rays on its own (and grows the layer)."""
     w = world
     origins = np.empty((w.ranger_offset.shape[0], 2))
     motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)

@@ -212,11 +212,15 @@ class Simulation:
         self.velocities = self._body_velocities()
         layer = self._updates % 2
         if self._fused is not None and self._sensing.all_due(self.sim_time):
-            self.true_poses, self.stalled, self.odometry_poses, self._layer_poses, ranges, intensities = \
-                self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
-                                 self.odometry_poses, self.odom_errors, self._uses_odom, dt)
+            fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
+                                     self.odometry_poses, self.odom_errors, self._uses_odom, dt)
+            self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
+                fused.poses, fused.stalled, fused.odometry, fused.layers
             self._updates += 1
-            self._sensing.record_all(ranges, intensities, self.sim_time)
+            if fused.scans is None:
+                self._sensing.sense(self.true_poses, self.sim_time, fused.raster)
+            else:
+                self._sensing.record_all(*fused.scans, self.sim_time)
         else:
             self._step_by_roles(layer, dt)
         if self._upgrade is not None:
@@ -248,7 +252,7 @@ class Simulation:
             return
         parts.sensing.adopt(self._sensing)
         self._collision, self._sensing, self._motion = parts.collision, parts.sensing, parts.backend.motion
-        self._fused = parts.backend.fused(self._collision, self._sensing.single_cast(), self.threads)
+        self._fused = parts.fused
         self.kernels = parts.backend.name
         self._upgrade = None
 
