@@ -172,10 +172,10 @@ class FusedStep:
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
         }
         self._beams = beams
-        self._known = self._fields["known"], self._fields["known_trig"], self._fields["headings"]
-        self._new_headings = self._fields["headings"][:, 2]  # numpy's cos and sin of a strided column, as the roles'
-        self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))  # end poses, cos and sin of the
-        # new headings and of the new poses
+        self._remembered = self._fields["known"], self._fields["known_trig"], self._fields["headings"]
+        self._new_headings = self._fields["headings"][:, 2]  # a strided column, as the roles' numpy cos and sin read
+        # scratch: the end poses, the cos and sin of the new headings and those of the new poses
+        self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))
         self._pack()
 
     def _pack(self) -> None:
@@ -190,9 +190,9 @@ class FusedStep:
 
     @classmethod
     def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
-        """The fused step of a world's compiled contacts and rays (None: not all at one height, or noisy), or None
-        when it steps role by role: robots in several height bands, or more than one thread with more rays than
-        a cast keeps on one (the parallel loops)."""
+        """The fused step of a world's compiled contacts and rays (``cast`` None: not all at one height, noise, or
+        no robot), or None when it steps role by role: robots in several height bands, or more than one thread
+        with more rays than a cast keeps on one (the parallel loops)."""
         if (cast is None or not isinstance(collision, CompiledCollisionChecker) or collision.static_layer() is None
                 or (threads > 1 and cast.group.rays.size > PARALLEL_RAYS)):
             return None
@@ -207,7 +207,7 @@ class FusedStep:
             self._pack()
         n, world, integrated, end_trig, final_trig = poses.shape[0], self._world, *self._scratch
         odometry = np.empty((n, 3))
-        known, known_trig, headings = self._known
+        known, known_trig, headings = self._remembered
         if not fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
                                      known_trig, True, integrated, odometry, headings):
             self._learn(poses, layers, layer, estimates)

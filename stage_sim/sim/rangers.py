@@ -147,7 +147,7 @@ class RangerSensing:
 
     def single_cast(self) -> SingleCast | None:
         """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
-        it can: all rays at one height, no noise, seen robots; else None (:meth:`sense` casts them)."""
+        it can: all rays at one height, no noise, a robot at least; else None (:meth:`sense` casts them)."""
         if len(self._groups) != 1 or self._noisy or not self._bodies.count:
             return None
         return SingleCast(self._groups[0], self._ranger_offset, self._ranger_owner, self._trig, self._no_jitter,
