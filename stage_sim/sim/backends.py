@@ -79,9 +79,9 @@ class Fused(Protocol):
     """A whole step in few calls, as the roles give it step by step (:meth:`~stage_sim.sim.compiled.FusedStep.step`)."""
 
     def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
-             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
              ) -> FusedResult:
-        """One step: :class:`~stage_sim.sim.compiled.FusedResult`."""
+        """One step, every ray cast when ``cast``, none else: :class:`~stage_sim.sim.compiled.FusedResult`."""
         ...
 
 

@@ -132,9 +132,9 @@ class FusedResult:
     odometry: np.ndarray
     layers: np.ndarray  #: (2, N, 3) the robots' poses in each of Stage's layers
     scans: tuple[np.ndarray, np.ndarray] | None
-    """float32 ranges and intensities of every beam; None when the robot layer had no room for the robots' tiles:
-    the sensing casts the rays then (and grows it)."""
-    raster: tuple[np.ndarray, np.ndarray]  #: (cell, robot) of the robots' cells the rays see
+    """float32 ranges and intensities of every beam; None when none was cast, or when the robot layer had no room
+    for the robots' tiles: the sensing casts the rays then (and grows it)."""
+    raster: tuple[np.ndarray, np.ndarray]  #: (cell, robot) of the robots' cells the rays see (when they are cast)
 
 
 class FusedStep:
@@ -199,9 +199,10 @@ class FusedStep:
         return cls(collision, cast)
 
     def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
-             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
              ) -> FusedResult:
-        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``, every ray cast."""
+        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``; every ray cast
+        when ``cast``, none else (no ranger due)."""
         robots = self._robots
         if robots.ids is not self._ids:
             self._pack()
@@ -219,7 +220,9 @@ class FusedStep:
         published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
         cells, cell_robot, marked, tiles, active = fused_kernels.step(
             world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
-            stalled_out, final_trig, robots.marked, robots.active, published, intensity)
+            stalled_out, final_trig, cast, robots.marked, robots.active, published, intensity)
+        if not cast:
+            return FusedResult(final, stalled_out, odometry, layers, None, (cells, cell_robot))
         robots.took(marked, active)
         scans = None if tiles > robots.capacity else (published, intensity)  # else the robot layer must grow
         return FusedResult(final, stalled_out, odometry, layers, scans, (cells, cell_robot))

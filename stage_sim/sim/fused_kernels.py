@@ -136,10 +136,10 @@ def advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, 
 
 @numba.njit(**_JIT)
 def step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
-         stalled_out, final_trig, old_marked, active, published, intensity):
+         stalled_out, final_trig, cast, old_marked, active, published, intensity):
     """The rest of a step after :func:`advance`: Stage's moves in layer ``layer`` of ``layers`` (2, N, 3), as
     :meth:`~stage_sim.sim.collision.CollisionChecker.resolve` and the simulation's step make them, then every
-    ray (:func:`sense`) from the new poses, through the robots where the layer now holds them.
+    ray (:func:`sense`) from the new poses, through the robots where the layer now holds them, when ``cast``.
 
     The robots with a velocity go to their end poses (``integrated``, whose headings' cos and sin are
     ``end_trig`` (2, 2N)) unless a cell of theirs there is a static cell of their height band or, when
@@ -147,7 +147,8 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
     robot order). Writes the new poses, stall flags and their cos and sin into ``final``, ``stalled_out`` and
     ``final_trig``, the layer's new poses into ``layers[layer]``, the true pose as odometry of the robots
     without ``uses_odom``, and what ``world.known`` and ``world.known_trig`` hold for the next step
-    (:func:`advance`). Returns :func:`sense`'s answer."""
+    (:func:`advance`). Returns the raster the rays saw and :func:`sense`'s answer (without a cast: the moves'
+    raster and the layer's state as given)."""
     n = poses.shape[0]
     known, known_trig, collides = world.known, world.known_trig, world.collides  # locals: each read of a field
     layer_poses = layers[layer].copy()  # counts a reference
@@ -206,6 +207,8 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
                 odometry[i, axis] = final[i, axis]
             known_trig[1, 0, i], known_trig[1, 1, i] = final_trig[0, i], final_trig[1, i]
         known[1, i] = odometry[i, 2]
+    if not cast:
+        return end_cells, end_robot, old_marked, 0, active
     if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
         cells, cell_robot = end_cells, end_robot
     else:

@@ -85,8 +85,11 @@ class RangerSensing:
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
         self._longest_us = int(self._interval_us.max(initial=0))
+        self._shortest_us = int(self._interval_us.min(initial=0))
         self._all_due_us = 0
         """From this sim time on every ranger is due (the common step, told without an array per ranger)."""
+        self._next_due_us = 0
+        """Before this sim time no ranger is due (the steps between a slow laser's scans)."""
         self._every_ray = np.ones(len(self._owner), dtype=bool)
         self._stale = True
 
@@ -100,6 +103,7 @@ class RangerSensing:
         self.latest = previous.latest
         self._last_us = previous._last_us.copy()
         self._all_due_us = previous._all_due_us
+        self._next_due_us = previous._next_due_us
         self._stale = previous._stale
         self._rng = previous._rng
 
@@ -123,6 +127,7 @@ class RangerSensing:
                 return
             self._last_us[due] = now_us
             self._all_due_us = int((self._last_us + self._interval_us).max())
+            self._next_due_us = int((self._last_us + self._interval_us).min())
         ray_due = None if due is None else due[self._ranger_of_ray]
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
@@ -145,6 +150,10 @@ class RangerSensing:
         """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
         return self._stale or round(time * 1e6) >= self._all_due_us
 
+    def none_due(self, time: float) -> bool:
+        """Whether no ranger is due at ``time`` (:meth:`sense` would cast nothing)."""
+        return not self._stale and round(time * 1e6) < self._next_due_us
+
     def single_cast(self) -> SingleCast | None:
         """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
         it can: all rays at one height, no noise, a robot at least; else None (:meth:`sense` casts them)."""
@@ -164,6 +173,7 @@ class RangerSensing:
         self._stale = False
         self._last_us[:] = now_us
         self._all_due_us = now_us + self._longest_us
+        self._next_due_us = now_us + self._shortest_us
 
     def _publish(self, rangers: Iterable[int], published: np.ndarray, intensity: np.ndarray, time: float) -> None:
         """New scans of ``rangers`` from the float32 ranges and intensities of all beams (views of their own)."""
