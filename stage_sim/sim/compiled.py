@@ -123,9 +123,10 @@ def hit_intensity(cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, r
         cell, hit_robot, static.cells, static.values, robot_return, robots_seen, SEVERAL_ROBOTS, several, rays, out)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class FusedResult:
-    """A fused step's new state (new arrays) and scans."""
+    """A fused step's new state (new arrays) and scans (not frozen: made every step, a frozen one sets each field
+    through ``object.__setattr__``)."""
 
     poses: np.ndarray
     stalled: np.ndarray
