@@ -108,7 +108,7 @@ class RobotLayer:
         tile = number[winner]
         flat_regions[region] = tile
         count = int(first.sum())
-        self._reserve(count)
+        self.reserve(count)
         self.ids[:count] = -1
         self.blocks[:count] = -1
         _write(self.ids, (tile, ty, tx), ids.astype(np.int32))
@@ -146,7 +146,7 @@ class RobotLayer:
         self._marked = marked
         self.active = active
 
-    def _reserve(self, count: int) -> None:
+    def reserve(self, count: int) -> None:
         """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
         if count > self.ids.shape[0]:
             capacity = max(count, 2 * self.ids.shape[0])
@@ -213,7 +213,7 @@ class CompiledRobotLayer(RobotLayer):
         self._marked, tile, local, count = robot_kernels.number_robot_regions(
             self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
             self.shape[1], MARKED)
-        self._reserve(count)
+        self.reserve(count)
         self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
                                                       self.owner, tile, local, ids.astype(np.int32), count,
                                                       SEVERAL_ROBOTS)

@@ -84,6 +84,10 @@ class Fused(Protocol):
         """One step, every ray cast when ``cast``, none else: :class:`~stage_sim.sim.compiled.FusedResult`."""
         ...
 
+    def warm(self, poses: np.ndarray) -> None:
+        """Load what its steps run (compiled kernels), with the robots at ``poses``."""
+        ...
+
 
 class FusedFactory(Protocol):
     """The fused step of a world's contacts and rays (:meth:`~stage_sim.sim.rangers.RangerSensing.single_cast`)

@@ -132,17 +132,15 @@ class FusedResult:
     stalled: np.ndarray
     odometry: np.ndarray
     layers: np.ndarray  #: (2, N, 3) the robots' poses in each of Stage's layers
-    scans: tuple[np.ndarray, np.ndarray] | None
-    """float32 ranges and intensities of every beam; None when none was cast, or when the robot layer had no room
-    for the robots' tiles: the sensing casts the rays then (and grows it)."""
-    raster: tuple[np.ndarray, np.ndarray]  #: (cell, robot) of the robots' cells the rays see (when they are cast)
+    scans: tuple[np.ndarray, np.ndarray] | None  #: float32 ranges and intensities of every beam (None: no cast)
 
 
 class FusedStep:
     """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
-    end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin
-    and the new arrays. For worlds whose robots share one height band and whose rays one height, without noise
-    and on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by role."""
+    end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin,
+    the noise's draws and the new arrays. For worlds whose robots share one height band and whose rays one
+    height, on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by
+    role."""
 
     def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast) -> None:
         bodies, grid = collision.bodies, collision.grid
@@ -161,7 +159,9 @@ class FusedStep:
             "visible": group.robot_visible, "region_place": group.robots.grid.place, "width": group.robots.shape[1],
             "marked_value": MARKED, "several": SEVERAL_ROBOTS, "walk_place": place, "stops": stops, "pad": pad,
             "walk_ppm": walk_ppm, "ranger": group.ranger, "angle": group.angle, "rmax": group.max_range,
-            "owner": group.owner, "rays": group.rays, "jitter": cast.no_jitter, "static_cells": group.intensity.cells,
+            "owner": group.owner, "rays": group.rays, "jitter": cast.jitter, "noisy_rays": cast.noisy_rays,
+            "noise_prop": cast.noise_prop, "noise_uniform": cast.noise_uniform, "noise_gauss": cast.noise_gauss,
+            "static_cells": group.intensity.cells,
             "static_values": group.intensity.values, "robot_return": group.robot_return,
             "several_return": float(group.robot_return.max(initial=0.0)), "ranges": np.empty(beams),
             "cell": np.empty(beams, dtype=np.int64), "hit_robot": np.empty(beams, dtype=np.int32),
@@ -191,9 +191,9 @@ class FusedStep:
 
     @classmethod
     def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
-        """The fused step of a world's compiled contacts and rays (``cast`` None: not all at one height, noise, or
-        no robot), or None when it steps role by role: robots in several height bands, or more than one thread
-        with more rays than a cast keeps on one (the parallel loops)."""
+        """The fused step of a world's compiled contacts and rays (``cast`` None: not all at one height, or no
+        robot), or None when it steps role by role: robots in several height bands, or more than one thread with
+        more rays than a cast keeps on one (the parallel loops)."""
         if (cast is None or not isinstance(collision, CompiledCollisionChecker) or collision.static_layer() is None
                 or (threads > 1 and cast.group.rays.size > PARALLEL_RAYS)):
             return None
@@ -223,10 +223,28 @@ class FusedStep:
             world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
             stalled_out, final_trig, cast, robots.marked, robots.active, published, intensity)
         if not cast:
-            return FusedResult(final, stalled_out, odometry, layers, None, (cells, cell_robot))
+            return FusedResult(final, stalled_out, odometry, layers, None)
         robots.took(marked, active)
-        scans = None if tiles > robots.capacity else (published, intensity)  # else the robot layer must grow
-        return FusedResult(final, stalled_out, odometry, layers, scans, (cells, cell_robot))
+        if tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
+            robots.reserve(tiles)
+            self._pack()
+            marked, _, active = fused_kernels.sense(self._world, final, final_trig, cells, cell_robot, robots.marked,
+                                                    robots.active, published, intensity)
+            robots.took(marked, active)
+        return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+
+    def warm(self, poses: np.ndarray) -> None:
+        """Load its kernels (compiling what numba's cache lacks): a step from ``poses`` and a cast into a grown
+        robot layer, whose results are dropped (what it remembers is checked at every step)."""
+        n = len(poses)
+        self.step(poses, np.stack([poses, poses]), 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
+                  np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
+        robots, final_trig = self._robots, self._scratch[2]
+        marked, _, active = fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64),
+                                                np.zeros(0, dtype=np.int64), robots.marked, robots.active,
+                                                np.empty(self._beams, dtype=np.float32),
+                                                np.empty(self._beams, dtype=np.float32))
+        robots.took(marked, active)
 
     def _learn(self, poses: np.ndarray, layers: np.ndarray, layer: int, estimates: np.ndarray) -> None:
         """Compute the cos and sin of the start headings anew (the first step, or poses set between steps)."""

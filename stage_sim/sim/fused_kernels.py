@@ -40,8 +40,10 @@ FIELDS = (
     # the walk: the static layer's masks, tiles, slots and used lines, place, stop map and margin
     "walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used", "walk_place", "stops",
     "pad", "walk_ppm",
-    # the rays: ranger, angle, range, robot, slot, jitter, last angle, cos and sin
-    "ranger", "angle", "rmax", "owner", "rays", "jitter", "last_angle", "last_cos", "last_sin",
+    # the rays: ranger, angle, range, robot, slot, last angle, cos and sin
+    "ranger", "angle", "rmax", "owner", "rays", "last_angle", "last_cos", "last_sin",
+    # noise, drawn before each cast: direction (empty: none); rays with a range noise, their p, U' and G
+    "jitter", "noisy_rays", "noise_prop", "noise_uniform", "noise_gauss",
     # intensities: static cells and values, robots' returns, the return of a cell two robots share
     "static_cells", "static_values", "robot_return", "several_return",
     # scratch: ranges, hit cells and robots; new headings, the remembered ones and their cos and sin
@@ -69,16 +71,18 @@ def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, c
                 tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids, rows,
                 cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value, several,
                 walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used, walk_place, stops, pad,
-                walk_ppm, ranger, angle, rmax, owner, rays, jitter, last_angle, last_cos, last_sin, static_cells,
-                static_values, robot_return, several_return, ranges, cell, hit_robot, headings, known, known_trig):
+                walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin, jitter, noisy_rays,
+                noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return, several_return,
+                ranges, cell, hit_robot, headings, known, known_trig):
     """A :class:`FusedWorld` of the :data:`FIELDS` (compiled and cached: the proxy's own constructor is not)."""
     return FusedWorld(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
                       tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions,
                       ids, rows, cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value,
                       several, walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used,
-                      walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, jitter, last_angle, last_cos,
-                      last_sin, static_cells, static_values, robot_return, several_return, ranges, cell, hit_robot,
-                      headings, known, known_trig)
+                      walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos,
+                      last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells,
+                      static_values, robot_return, several_return, ranges, cell, hit_robot, headings, known,
+                      known_trig)
 
 
 @numba.njit(**_JIT)
@@ -221,15 +225,15 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
 @numba.njit(**_JIT)
 def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, intensity):
     """Every ray of one height cast from ``poses`` (their cos and sin ``trig``, (2, N)) as
-    :meth:`~stage_sim.sim.rangers.RangerSensing.sense` casts them when all rangers are due and without noise:
-    the rangers' origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; ``old_marked``,
-    ``active``: the layer's regions marked and whether it holds a cell), the walk, the intensities, the float32
-    ranges.
+    :meth:`~stage_sim.sim.rangers.RangerSensing.sense` casts them when all rangers are due: the rangers'
+    origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; ``old_marked``, ``active``: the
+    layer's regions marked and whether it holds a cell), the walk (with the direction noise drawn), the
+    intensities, the range noise drawn (r + r·p·U' + G for a hit), the float32 ranges.
 
     With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
     layer's tiles, else their regions are only marked. Returns (regions marked, tiles needed, whether the
     layer holds a cell); when the layer has room for fewer tiles than needed (``world.capacity``) nothing is
-    cast: the caller casts the rays on its own (and grows the layer)."""
+    cast: the caller grows it and calls again."""
     w = world
     origins = np.empty((w.ranger_offset.shape[0], 2))
     motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)
@@ -256,6 +260,11 @@ def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, 
         w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
     ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
                                  w.several, w.several_return, w.rays, intensity)
+    noisy_rays, rmax, prop, uniform, gauss = w.noisy_rays, w.rmax, w.noise_prop, w.noise_uniform, w.noise_gauss
+    for k in range(noisy_rays.size):
+        i = noisy_rays[k]
+        if ranges[i] < rmax[i]:
+            ranges[i] = ranges[i] + ranges[i] * prop[k] * uniform[k] + gauss[k]
     for i in range(ranges.size):
         published[i] = np.float32(ranges[i])
     return marked, count, active

@@ -123,9 +123,7 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     # raster and decision kernels (nothing is kept)
     sensing.sense(poses, 0.0)
     fused = backend.fused(collision, sensing.single_cast(), sim.threads)
-    if fused is not None:  # loads its kernels too (nothing is kept but what it remembers, checked at every step)
-        n = len(poses)
-        fused.step(poses, np.stack([poses, poses]), 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
-                   np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
+    if fused is not None:
+        fused.warm(poses)
     note_kernels_running(backend.name)
     return CompiledParts(collision, sensing, backend, fused)

@@ -81,6 +81,7 @@ class RangerSensing:
         # that did not turn (a stalled one) does not compute them again
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
+        self._all_cast = self._all_cast_noise()
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
@@ -156,11 +157,24 @@ class RangerSensing:
 
     def single_cast(self) -> SingleCast | None:
         """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
-        it can: all rays at one height, no noise, a robot at least; else None (:meth:`sense` casts them)."""
-        if len(self._groups) != 1 or self._noisy or not self._bodies.count:
+        it can: all rays at one height, a robot at least; else None (:meth:`sense` casts them)."""
+        if len(self._groups) != 1 or not self._bodies.count:
             return None
-        return SingleCast(self._groups[0], self._ranger_offset, self._ranger_owner, self._trig, self._no_jitter,
-                          float(self._max_range.max(initial=0.0)))
+        jitter, _, _, noisy_rays, prop, _, uniform, gauss = self._all_cast
+        return SingleCast(self._groups[0], self._ranger_offset, self._ranger_owner, self._trig,
+                          float(self._max_range.max(initial=0.0)), jitter, noisy_rays, prop, uniform, gauss)
+
+    def draw_all_noise(self) -> None:
+        """Draw the noise of a cast of every ray into :meth:`single_cast`'s buffers, before a fused step casts
+        them: the draws :meth:`sense` makes for it, in its order (directions, then U', then G)."""
+        if not self._noisy:
+            return
+        jitter, jitter_rays, jitter_scale, noisy_rays, _, sqrt_const, uniform, gauss = self._all_cast
+        if jitter_rays.size:
+            jitter[jitter_rays] = jitter_scale * self._rng.uniform(-1.0, 1.0, len(jitter_rays))
+        if noisy_rays.size:
+            uniform[:] = self._rng.uniform(-1.0, 1.0, len(noisy_rays))
+            gauss[:] = self._rng.normal(0.0, 1.0, len(noisy_rays)) * sqrt_const
 
     def record_all(self, published: np.ndarray, intensity: np.ndarray, time: float) -> None:
         """Take the scans of every ranger cast at ``time`` by a fused step (when :meth:`all_due`): what
@@ -210,6 +224,19 @@ class RangerSensing:
         # a lone robot never sees itself
         self._backend.hit_intensity(cell, hit_robot, group.intensity, group.robot_return, self._bodies.count > 1,
                                     rays, intensity, self._grid.threads)
+
+    def _all_cast_noise(self) -> tuple[np.ndarray, ...]:
+        """What the noise of a cast of every ray needs, worked out as :meth:`_angle_jitter` and :meth:`_apply_noise`
+        work it out (the same arithmetic): the jitter (its buffer, rays and scale), the rays with a range noise,
+        their proportional noise and the square root of their constant one, buffers for U' and G."""
+        angle_noise = self._ray_noise[:, 2]
+        jitter_rays = np.flatnonzero(angle_noise != 0.0)
+        jitter_scale = self._increment[self._ranger_of_ray[jitter_rays]] * angle_noise[jitter_rays] / 2
+        noisy_rays = np.flatnonzero(np.any(self._ray_noise != 0.0, axis=1))
+        const, prop = self._ray_noise[noisy_rays, 0], self._ray_noise[noisy_rays, 1]
+        jitter = np.zeros(len(self._owner)) if self._angle_noisy else self._no_jitter
+        return (jitter, jitter_rays, jitter_scale, noisy_rays, prop, np.sqrt(const), np.empty(noisy_rays.size),
+                np.empty(noisy_rays.size))
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
         """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle

@@ -41,5 +41,9 @@ class SingleCast:
     ranger_offset: np.ndarray  #: (K, 2) each ranger's origin in its robot's frame
     ranger_owner: np.ndarray  #: (K,) each ranger's robot
     trig: tuple[np.ndarray, np.ndarray, np.ndarray]  #: every beam's last angle, cos and sin (kept up to date)
-    no_jitter: np.ndarray  #: the empty jitter of a cast without angle noise
     longest: float  #: the longest beam's range
+    jitter: np.ndarray  #: every beam's direction noise, drawn anew before each cast (empty: no angle noise)
+    noisy_rays: np.ndarray  #: the beams with a range noise ...
+    noise_prop: np.ndarray  #: ... their proportional noise ...
+    noise_uniform: np.ndarray  #: ... and their draws of U' ...
+    noise_gauss: np.ndarray  #: ... and of G, drawn anew before each cast (``RangerSensing.draw_all_noise``)

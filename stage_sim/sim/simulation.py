@@ -213,14 +213,14 @@ class Simulation:
         layer = self._updates % 2
         cast = self._fused is not None and self._sensing.all_due(self.sim_time)
         if cast or (self._fused is not None and self._sensing.none_due(self.sim_time)):  # else only some rangers
+            if cast:
+                self._sensing.draw_all_noise()
             fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
                                      self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast)
             self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
                 fused.poses, fused.stalled, fused.odometry, fused.layers
             self._updates += 1
-            if cast and fused.scans is None:
-                self._sensing.sense(self.true_poses, self.sim_time, fused.raster)
-            elif cast:
+            if cast:
                 self._sensing.record_all(*fused.scans, self.sim_time)
         else:
             self._step_by_roles(layer, dt)

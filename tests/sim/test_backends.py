@@ -81,12 +81,13 @@ def _frames(sim: Simulation, steps: int, seed: int) -> list[tuple]:
     return frames
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-def test_the_fused_step_gives_the_role_by_role_answers(threads):
-    from tests.sim.test_step_digests import quiet_crowd
+@pytest.mark.parametrize(("threads", "noisy"), [(1, False), (2, False), (1, True)])
+def test_the_fused_step_gives_the_role_by_role_answers(threads, noisy):
+    from tests.sim.test_step_digests import crowd
 
-    world = load_world_text(quiet_crowd(2).replace("samples 271", "samples 41"), "crowd.world")  # few enough rays
-    # for one thread's cast
+    text = crowd(2).replace(" size [0.4 0.3 0.05]", "").replace("samples 271", "samples 41")  # one height band,
+    # few enough rays for one thread's cast
+    world = load_world_text(text if noisy else text.replace(" noise [0.0004 0.01 0.5]", ""), "crowd.world")
     fused = Simulation(world, seed=4, kernels="numba", threads=threads)
     by_roles = Simulation(world, seed=4, kernels="numba", threads=threads)
     by_roles._fused = None
@@ -94,7 +95,7 @@ def test_the_fused_step_gives_the_role_by_role_answers(threads):
     assert _frames(fused, 30, 4) == _frames(by_roles, 30, 4)
 
 
-def test_noise_and_several_heights_step_role_by_role():
+def test_robots_in_several_height_bands_step_role_by_role():
     from tests.sim.test_step_digests import crowd
 
     assert Simulation(load_world_text(crowd(0), "crowd.world"), seed=0, kernels="numba")._fused is None
