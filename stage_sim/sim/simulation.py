@@ -211,21 +211,27 @@ class Simulation:
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
         layer = self._updates % 2
-        cast = self._fused is not None and self._sensing.all_due(self.sim_time)
-        if cast or (self._fused is not None and self._sensing.none_due(self.sim_time)):  # else only some rangers
-            if cast:
-                self._sensing.draw_all_noise()
-            fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
-                                     self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast)
-            self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
-                fused.poses, fused.stalled, fused.odometry, fused.layers
-            self._updates += 1
-            if cast:
-                self._sensing.record_all(*fused.scans, self.sim_time)
+        fused = self._fused is not None
+        cast = fused and self._sensing.all_due(self.sim_time)
+        if cast or (fused and self._sensing.none_due(self.sim_time)):  # a fused step casts all rangers or none
+            self._step_fused(layer, dt, cast)
         else:
             self._step_by_roles(layer, dt)
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
+
+    def _step_fused(self, layer: int, dt: float, cast: bool) -> None:
+        """The moves, odometry and (when ``cast``) every ranger's scan of a step in few compiled calls, the same
+        as :meth:`_step_by_roles` gives (the backend's fused step)."""
+        if cast:
+            self._sensing.draw_all_noise()
+        fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
+                                 self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast)
+        self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
+            fused.poses, fused.stalled, fused.odometry, fused.layers
+        self._updates += 1
+        if cast:
+            self._sensing.record_all(*fused.scans, self.sim_time)
 
     def _step_by_roles(self, layer: int, dt: float) -> None:
         """The moves, odometry and scans of a step, one role after the other (what the fused step does at once)."""
