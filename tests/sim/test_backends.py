@@ -100,3 +100,33 @@ def test_robots_in_several_height_bands_step_role_by_role():
 
     assert Simulation(load_world_text(crowd(0), "crowd.world"), seed=0, kernels="numba")._fused is None
     assert Simulation(load_world_text(WORLD, "two.world"), seed=0, kernels="numba")._fused is not None
+
+
+MIXED = """
+resolution 0.02
+interval_sim 100
+define wall model ( color "black" )
+wall( size [4 0.04 1] pose [2 0 0 0] )
+wall( size [4 0.04 1] pose [2 3 0 0] )
+wall( size [0.04 3 1] pose [0 1.5 0 0] )
+wall( size [0.04 3 1] pose [4 1.5 0 0] )
+define laser ranger ( sensor( range [0 3] fov 270 samples 61 noise [0.0 0.02 0.0] ) size [0.05 0.05 0.05] )
+define bot position ( size [0.4 0.3 0.2] laser( pose [0.1 0 -0.1 0] ) )
+bot( pose [1 1 0 0] localization "odom" )
+position( pose [1.5 1 0 90] size [0.4 0.3 0.2] )
+bot( pose [2 1 0 180] obstacle_return 0 drive "omni" )
+bot( pose [2.5 2 0 45] ranger_return -1 drive "car" )
+bot( pose [1.2 2.2 0 -30] laser( pose [-0.1 0 -0.1 180] ) )
+"""
+"""A robot without a laser, one no robot collides with, one no laser sees, gps and odom, three drives."""
+
+
+def test_the_fused_step_on_a_mixed_world_gives_the_reference_answers():
+    world = load_world_text(MIXED, "mixed.world")
+    fused = Simulation(world, seed=3, kernels="numba")
+    by_roles = Simulation(world, seed=3, kernels="numba")
+    by_roles._fused = None
+    assert fused._fused is not None
+    reference = _frames(Simulation(world, seed=3, kernels="numpy"), 40, 3)
+    assert _frames(fused, 40, 3) == reference
+    assert _frames(by_roles, 40, 3) == reference
