@@ -22,6 +22,8 @@ from stage_sim.sensing.robot_layer import CompiledRobotLayer
 from stage_sim.sensing.stage_walk import ray_arguments, static_layer
 from stage_sim.sensing.stop_map import StopMap
 
+#: Rays from which a cast on more than one thread runs the parallel loop.
+PARALLEL_RAYS = 1024
 _NONE = np.zeros(0)  # an absent jitter or trigonometry cache
 _NO_REGIONS = np.zeros(0, dtype=np.int64)  # no robot layer's regions
 
@@ -72,6 +74,12 @@ class NumbaRayCaster:
                                          ranges)
         return CastResult(ranges=ranges, hit_cell=cell, hit_robot=hit_robot)
 
+    def walk_arguments(self, longest: float) -> tuple[tuple, np.ndarray, np.ndarray, int, float]:
+        """What :func:`~stage_sim.sensing.traversal.cast_serial` reads of this caster for rays of up to
+        ``longest`` metres, as :meth:`cast_into` gives it: (world, place, stop map, its margin, cells per metre)."""
+        stops, pad = self._stops.fitted(longest / self.resolution)
+        return self._world, self._place, stops, pad, 1.0 / self.resolution
+
     def cast_into(
         self, origins: np.ndarray, origin_of: np.ndarray, heading: np.ndarray, local: np.ndarray, rmax: np.ndarray,
         owners: np.ndarray, robots: CompiledRobotLayer | None, out_at: np.ndarray, out: np.ndarray,
@@ -84,9 +92,7 @@ class NumbaRayCaster:
         reuses for beams whose angle did not change. Returns (hit cell, hit robot) per ray. Arrays: int64
         indices, float64 values, C-contiguous."""
         n = owners.size
-        layer = (self._no_robots if robots is None else
-                 (robots.regions, robots.ids, robots.rows, robots.cols, robots.rows_used, robots.cols_used,
-                  robots.owner))
+        layer = self._no_robots if robots is None else robots.tables
         flags = (robots is not None, robots is not None and robots.active)
         marked = _NO_REGIONS if robots is None else robots.marked
         stops, pad = self._stops.fitted(float(rmax.max(initial=0.0)) / self.resolution)
@@ -94,7 +100,7 @@ class NumbaRayCaster:
         hit_robot = np.empty(n, dtype=np.int32)
         args = (self._world, layer, flags, self._place, stops, pad, marked, origins, origin_of, heading, local, jitter,
                 trig, rmax, 1.0 / self.resolution, owners, out_at, out, cell, hit_robot)
-        if self.threads > 1 and n > 1024:
+        if self.threads > 1 and n > PARALLEL_RAYS:
             set_threads(self.threads)
             traversal.cast_parallel(*args)
         else:

@@ -108,7 +108,7 @@ class RobotLayer:
         tile = number[winner]
         flat_regions[region] = tile
         count = int(first.sum())
-        self._reserve(count)
+        self.reserve(count)
         self.ids[:count] = -1
         self.blocks[:count] = -1
         _write(self.ids, (tile, ty, tx), ids.astype(np.int32))
@@ -135,7 +135,18 @@ class RobotLayer:
         rows[off] = cols[off] = -1
         return rows, cols
 
-    def _reserve(self, count: int) -> None:
+    @property
+    def capacity(self) -> int:
+        """Tiles the layer has room for."""
+        return self.ids.shape[0]
+
+    def took(self, marked: np.ndarray, active: bool) -> None:
+        """Note an update made elsewhere (a fused step's kernels): the regions it marked and whether it wrote a
+        cell (what the next update clears, what the next cast reads)."""
+        self._marked = marked
+        self.active = active
+
+    def reserve(self, count: int) -> None:
         """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
         if count > self.ids.shape[0]:
             capacity = max(count, 2 * self.ids.shape[0])
@@ -202,10 +213,15 @@ class CompiledRobotLayer(RobotLayer):
         self._marked, tile, local, count = robot_kernels.number_robot_regions(
             self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
             self.shape[1], MARKED)
-        self._reserve(count)
+        self.reserve(count)
         self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
                                                       self.owner, tile, local, ids.astype(np.int32), count,
                                                       SEVERAL_ROBOTS)
+
+    @property
+    def tables(self) -> tuple[np.ndarray, ...]:
+        """What the compiled walk reads: (regions, ids, row masks, column masks, used rows, used columns, owner)."""
+        return self.regions, self.ids, self.rows, self.cols, self.rows_used, self.cols_used, self.owner
 
     def _grow(self, capacity: int) -> None:
         self.rows = np.empty((capacity, TILE), dtype=np.uint32)

@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache, partial
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -31,7 +31,11 @@ from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame
 from stage_sim.sim.drives import DriveGroup
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import integrate_odometry
+from stage_sim.sim.ray_groups import SingleCast
 from stage_sim.sim.returns import hit_intensity
+
+if TYPE_CHECKING:
+    from stage_sim.sim.compiled import FusedResult
 
 
 class CasterFactory(Protocol):
@@ -69,6 +73,31 @@ class Motion(Protocol):
     def warm(self, robots: int) -> None:
         """Load what the first step would load (compiled kernels), for ``robots`` robots."""
         ...
+
+
+class Fused(Protocol):
+    """A whole step in few calls, as the roles give it step by step (:meth:`~stage_sim.sim.compiled.FusedStep.step`)."""
+
+    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
+             ) -> FusedResult:
+        """One step, every ray cast when ``cast``, none else: :class:`~stage_sim.sim.compiled.FusedResult`."""
+        ...
+
+    def warm(self, poses: np.ndarray) -> None:
+        """Load what its steps run (compiled kernels), with the robots at ``poses``."""
+        ...
+
+
+class FusedFactory(Protocol):
+    """The fused step of a world's contacts and rays (:meth:`~stage_sim.sim.rangers.RangerSensing.single_cast`)
+    on ``threads``, or None where it steps role by role."""
+
+    def __call__(self, collision: Contact, cast: SingleCast | None, threads: int) -> Fused | None: ...
+
+
+def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int) -> None:
+    """The numpy reference steps role by role: it is what every fused step must give."""
 
 
 class HitIntensity(Protocol):
@@ -109,17 +138,19 @@ class Backend:
     contact: ContactFactory
     motion: Motion
     hit_intensity: HitIntensity
+    fused: FusedFactory
 
 
 def _numpy() -> Backend:
-    return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity)
+    return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity,
+                   no_fused_step)
 
 
 def _numba() -> Backend:
     from stage_sim.sim import compiled  # imports numba
 
     return Backend("numba", partial(make_caster, kernels="numba"), compiled.CompiledCollisionChecker,
-                   compiled.CompiledMotion(), compiled.hit_intensity)
+                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of)
 
 
 #: Every backend by name, built on first request.

@@ -194,14 +194,18 @@ class CollisionChecker:
         self.grid = grid
         self._layers = layers
         self._layer_of_robot = layer_of_robot
-        self._collides = collides
-        self._robots_can_clash = int(np.count_nonzero(collides)) > 1
-        self._colliding = np.flatnonzero(collides)
+        self.collides = collides  #: per robot: whether it stops other robots (and is tested against them)
+        self.robots_can_clash = int(np.count_nonzero(collides)) > 1
+        self.colliding = np.flatnonzero(collides)  #: the robots that do
         self._everyone = np.arange(bodies.count, dtype=np.int64)
         self._vertex_robot = bodies.vertex_robot
         self._next_vertex = bodies.next_vertex
         self._recent: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
         """Rasters of every robot by the bytes of their poses, oldest first (:meth:`_raster_of`)."""
+
+    def static_layer(self) -> TileLayer | None:
+        """The static cells every robot is tested against, when all robots share one height band."""
+        return self._layers[0] if len(self._layers) == 1 else None
 
     def resolve(self, poses: np.ndarray, layer_poses: np.ndarray, velocities: np.ndarray, dt: float,
                 moving: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -211,16 +215,16 @@ class CollisionChecker:
         refused = np.zeros(len(poses), dtype=bool)
         if moving.all():  # the common case, without the fancy indexing
             candidates = self._integrate(poses, velocities, dt)
-            testers = self._colliding
+            testers = self.colliding
         else:
             candidates = poses.copy()
             candidates[moving] = self._integrate(poses[moving], velocities[moving], dt)
-            testers = np.flatnonzero(moving & self._collides)
+            testers = np.flatnonzero(moving & self.collides)
         if testers.size:
             cells, owner = self._raster_of(candidates, testers)
             static_hit = self._static_hits(cells, owner)
-            if self._robots_can_clash:
-                others = self._colliding
+            if self.robots_can_clash:
+                others = self.colliding
                 before = self._raster_of(layer_poses, others)
                 back = self._raster_of(poses, testers)
                 self._decide(testers, static_hit, (cells, owner), before, back, (candidates, layer_poses, poses),
@@ -233,13 +237,13 @@ class CollisionChecker:
 
     def overlapping(self, poses: np.ndarray) -> np.ndarray:
         """Robots whose bodies at ``poses`` already share a cell with a static obstacle or another robot."""
-        everyone = self._colliding
+        everyone = self.colliding
         touching = np.zeros(len(poses), dtype=bool)
         if not everyone.size:
             return touching
         cells, owner = self._raster(poses, everyone)
         touching |= self._static_hits(cells, owner)
-        if self._robots_can_clash:
+        if self.robots_can_clash:
             start, _ = shared_cells(cells, owner, cells, owner, everyone)
             touching[everyone[np.diff(start) > 0]] = True
         return touching

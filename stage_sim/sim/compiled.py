@@ -10,17 +10,22 @@ twin, on the grid's threads, from :data:`PARALLEL_ITEMS` items on.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from types import ModuleType
 
 import numpy as np
 
 from stage_sim.backend import set_threads
 from stage_sim.maps.tiles import CellValues
-from stage_sim.sensing.robot_layer import SEVERAL_ROBOTS
-from stage_sim.sim import body_kernels, motion_kernels, ranger_kernels
-from stage_sim.sim.collision import CollisionChecker
+from stage_sim.sensing.fast_caster import PARALLEL_RAYS
+from stage_sim.sensing.robot_layer import MARKED, SEVERAL_ROBOTS
+from stage_sim.sim import body_kernels, fused_kernels, motion_kernels, ranger_kernels
+from stage_sim.sim.collision import CollisionChecker, Contact
 from stage_sim.sim.drives import DriveGroup
+from stage_sim.sim.ray_groups import SingleCast
 
+#: The steering cos and sin given to drives that read none (``Drive.steered``).
+_UNSTEERED = np.zeros(0)
 # Items (points, probes, robot pairs, rays) from which a compiled loop is shared among threads.
 PARALLEL_ITEMS = 4096
 
@@ -62,7 +67,7 @@ class CompiledCollisionChecker(CollisionChecker):
                 poses: tuple, refused: np.ndarray) -> None:
         candidates, layer_poses, start_poses = poses
         box = np.stack([self._boxes(p) for p in (layer_poses, candidates, start_poses)])
-        body_kernels.move_one_by_one(testers, static_hit, *cand, *before, *back, self._colliding, box, refused)
+        body_kernels.move_one_by_one(testers, static_hit, *cand, *before, *back, self.colliding, box, refused)
 
     def _boxes(self, poses: np.ndarray) -> np.ndarray:
         """(col min, row min, col max, row max) world cells holding each robot's raster at ``poses``: its
@@ -81,9 +86,13 @@ class CompiledMotion:
     @staticmethod
     def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
                         ) -> np.ndarray:
-        steer = commands[:, 2]
         out = np.empty_like(commands)
-        motion_kernels.body_velocities(commands, drives, wheelbases, bounds, np.cos(steer), np.sin(steer), out)
+        cos_steer = sin_steer = _UNSTEERED
+        for group in drives:
+            if group.drive.steered:
+                steer = commands[:, 2]
+                cos_steer, sin_steer = np.cos(steer), np.sin(steer)
+        motion_kernels.body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out)
         return out
 
     @staticmethod
@@ -112,3 +121,143 @@ def hit_intensity(cell: np.ndarray, hit_robot: np.ndarray, static: CellValues, r
     several = float(robot_return.max(initial=0.0))
     kernel(ranger_kernels, "hit_intensity", cell.size, threads)(
         cell, hit_robot, static.cells, static.values, robot_return, robots_seen, SEVERAL_ROBOTS, several, rays, out)
+
+
+@dataclass(slots=True)
+class FusedResult:
+    """A fused step's new state (new arrays) and scans (not frozen: made every step, a frozen one sets each field
+    through ``object.__setattr__``)."""
+
+    poses: np.ndarray
+    stalled: np.ndarray
+    odometry: np.ndarray
+    layers: np.ndarray  #: (2, N, 3) the robots' poses in each of Stage's layers
+    scans: tuple[np.ndarray, np.ndarray] | None  #: float32 ranges and intensities of every beam (None: no cast)
+
+
+class FusedStep:
+    """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
+    end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin,
+    the noise's draws and the new arrays. For worlds whose robots share one height band and whose rays one
+    height, on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by
+    role."""
+
+    def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast) -> None:
+        bodies, grid = collision.bodies, collision.grid
+        static = collision.static_layer()
+        group = cast.group
+        n, beams = bodies.count, group.rays.size
+        world, place, stops, pad, walk_ppm = group.caster.walk_arguments(cast.longest)
+        self._robots = group.robots
+        self._fields = {
+            "vertices": bodies.vertices, "poly_start": bodies.poly_start, "robot_poly": bodies.robot_poly,
+            "radius": bodies.radius, "grid": np.array([*grid.corner, *grid.shape, static.grid.shape[1]]),
+            "ppm": 1.0 / grid.resolution, "collides": collision.collides, "colliding": collision.colliding,
+            "can_clash": collision.robots_can_clash, "slots": static.grid.slots, "tile_of_slot": static.tile_of_slot,
+            "bits": static.bits, "static_place": static.grid.place, "ranger_offset": cast.ranger_offset,
+            "ranger_owner": cast.ranger_owner, "robots_seen": n > 1,  # a lone robot never sees itself
+            "visible": group.robot_visible, "region_place": group.robots.grid.place, "width": group.robots.shape[1],
+            "marked_value": MARKED, "several": SEVERAL_ROBOTS, "walk_place": place, "stops": stops, "pad": pad,
+            "walk_ppm": walk_ppm, "ranger": group.ranger, "angle": group.angle, "rmax": group.max_range,
+            "owner": group.owner, "rays": group.rays, "jitter": cast.jitter, "noisy_rays": cast.noisy_rays,
+            "noise_prop": cast.noise_prop, "noise_uniform": cast.noise_uniform, "noise_gauss": cast.noise_gauss,
+            "static_cells": group.intensity.cells,
+            "static_values": group.intensity.values, "robot_return": group.robot_return,
+            "several_return": float(group.robot_return.max(initial=0.0)), "ranges": np.empty(beams),
+            "cell": np.empty(beams, dtype=np.int64), "hit_robot": np.empty(beams, dtype=np.int32),
+            "headings": np.zeros((2 * n, 3)),  # column 2: a step's new headings (end poses, then odometry) ...
+            "known": np.full((4, n), np.nan),  # ... the headings of the poses, odometry, layers 0 and 1 ...
+            "known_trig": np.empty((4, 2, n)),  # ... and their numpy cos and sin
+            **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
+                       world, strict=True)),
+            **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
+        }
+        self._beams = beams
+        self._remembered = self._fields["known"], self._fields["known_trig"], self._fields["headings"]
+        self._new_headings = self._fields["headings"][:, 2]  # a strided column, as the roles' numpy cos and sin read
+        # scratch: the end poses, the cos and sin of the new headings and those of the new poses
+        self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))
+        self._pack()
+
+    def _pack(self) -> None:
+        """The fields in one argument, with the robot layer's tables as they stand (they grow, rarely; the
+        sensing's own casts may grow them too)."""
+        robots = self._robots
+        self._ids = robots.ids
+        tables = dict(zip(("regions", "ids", "rows", "cols", "rows_used", "cols_used", "tile_owner"), robots.tables,
+                          strict=True))
+        fields = {**self._fields, **tables, "capacity": robots.capacity}
+        self._world = fused_kernels.fused_world(*(fields[name] for name in fused_kernels.FIELDS))
+
+    @classmethod
+    def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
+        """The fused step of a world's compiled contacts and rays (``cast`` None: not all at one height, or no
+        robot), or None when it steps role by role: robots in several height bands, or more than one thread with
+        more rays than a cast keeps on one (the parallel loops)."""
+        if (cast is None or not isinstance(collision, CompiledCollisionChecker) or collision.static_layer() is None
+                or (threads > 1 and cast.group.rays.size > PARALLEL_RAYS)):
+            return None
+        return cls(collision, cast)
+
+    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
+             estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
+             ) -> FusedResult:
+        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``; every ray cast
+        when ``cast``, none else (no ranger due)."""
+        robots = self._robots
+        if robots.ids is not self._ids:
+            self._pack()
+        n, world, integrated, end_trig, final_trig = poses.shape[0], self._world, *self._scratch
+        odometry = np.empty((n, 3))
+        known, known_trig, headings = self._remembered
+        if not fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
+                                     known_trig, True, integrated, odometry, headings):
+            self._learn(poses, layers, layer, estimates)
+            fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
+                                  known_trig, False, integrated, odometry, headings)
+        np.cos(self._new_headings, out=end_trig[0])
+        np.sin(self._new_headings, out=end_trig[1])
+        final, stalled_out, layers = np.empty((n, 3)), np.empty(n, dtype=bool), layers.copy()
+        published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
+        cells, cell_robot, marked, tiles, active = fused_kernels.step(
+            world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
+            stalled_out, final_trig, cast, robots.marked, robots.active, published, intensity)
+        if not cast:
+            return FusedResult(final, stalled_out, odometry, layers, None)
+        robots.took(marked, active)
+        if tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
+            robots.reserve(tiles)
+            self._pack()
+            marked, _, active = fused_kernels.sense(self._world, final, final_trig, cells, cell_robot, robots.marked,
+                                                    robots.active, published, intensity)
+            robots.took(marked, active)
+        return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+
+    def warm(self, poses: np.ndarray) -> None:
+        """Load its kernels (compiling what numba's cache lacks): a step from ``poses`` and a cast into a grown
+        robot layer, whose results are dropped (what it remembers is checked at every step)."""
+        n = len(poses)
+        self.step(poses, np.stack([poses, poses]), 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
+                  np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
+        robots, final_trig = self._robots, self._scratch[2]
+        marked, _, active = fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64),
+                                                np.zeros(0, dtype=np.int64), robots.marked, robots.active,
+                                                np.empty(self._beams, dtype=np.float32),
+                                                np.empty(self._beams, dtype=np.float32))
+        robots.took(marked, active)
+
+    def _learn(self, poses: np.ndarray, layers: np.ndarray, layer: int, estimates: np.ndarray) -> None:
+        """Compute the cos and sin of the start headings anew (the first step, or poses set between steps)."""
+        known, known_trig = self._fields["known"], self._fields["known_trig"]
+        for row, source in ((0, poses), (1, estimates), (2 + layer, layers[layer])):
+            known[row] = source[:, 2]
+            known_trig[row] = _trig(source)
+
+
+def _trig(poses: np.ndarray) -> np.ndarray:
+    """(2, N): numpy's cos and sin of the headings ``poses[:, 2]``, the calls the role-by-role kernels make."""
+    heading = poses[:, 2]
+    trig = np.empty((2, heading.size))
+    np.cos(heading, out=trig[0])
+    np.sin(heading, out=trig[1])
+    return trig

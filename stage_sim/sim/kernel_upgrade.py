@@ -56,18 +56,20 @@ class Upgradable(Protocol):
 
     robots: list
     start_poses: np.ndarray
+    threads: int
 
     def build_parts(self, kernels: str) -> tuple[Any, Any]: ...
 
 
 @dataclass(frozen=True)
 class CompiledParts:
-    """What a simulation swaps in: the compiled collision checker and ray sensing, and the backend they are of
-    (its motion kernels, its name)."""
+    """What a simulation swaps in: the compiled collision checker and ray sensing, the backend they are of (its
+    motion kernels, its name) and their fused step (None: the world steps role by role)."""
 
     collision: Any
     sensing: Any
     backend: Backend
+    fused: Any
 
 
 class KernelUpgrade:
@@ -120,5 +122,8 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     collision.resolve(poses, poses, np.full_like(poses, 1e-3), 0.1, np.ones(len(poses), dtype=bool))  # loads the
     # raster and decision kernels (nothing is kept)
     sensing.sense(poses, 0.0)
+    fused = backend.fused(collision, sensing.single_cast(), sim.threads)
+    if fused is not None:
+        fused.warm(poses)
     note_kernels_running(backend.name)
-    return CompiledParts(collision, sensing, backend)
+    return CompiledParts(collision, sensing, backend, fused)

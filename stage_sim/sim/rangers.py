@@ -12,17 +12,16 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from stage_sim.maps.raster import StaticRaster
-from stage_sim.maps.tiles import CellValues
 from stage_sim.sensing.casters import RayCaster
-from stage_sim.sensing.robot_layer import RobotLayer
 from stage_sim.sim.collision import Bodies, GridFrame
+from stage_sim.sim.ray_groups import HeightGroup, SingleCast
 from stage_sim.sim.robots import RobotSpec
 
 if TYPE_CHECKING:
@@ -52,22 +51,6 @@ class MeasuredBeams:
     """Which rangers measured (bool per ranger), None: all of them."""
     ray_due: np.ndarray | None
     """The same per beam."""
-
-
-@dataclass(frozen=True)
-class _HeightGroup:
-    """The rays cast at one height, with the static layer and the robots visible there."""
-
-    rays: np.ndarray
-    owner: np.ndarray  #: per ray of the group: its robot, ranger, angle in the robot frame and range
-    ranger: np.ndarray
-    angle: np.ndarray
-    max_range: np.ndarray
-    caster: RayCaster
-    robots: RobotLayer
-    intensity: CellValues
-    robot_visible: np.ndarray
-    robot_return: np.ndarray
 
 
 class RangerSensing:
@@ -114,14 +97,18 @@ class RangerSensing:
         # that did not turn (a stalled one) does not compute them again
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
+        self._all_cast = self._all_cast_noise()
         self.latest: list[list[Scan]] = [[] for _ in robots]
         self.measured: MeasuredBeams | None = None
         """The beams of the last sensing that cast any (None before the first)."""
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
         self._longest_us = int(self._interval_us.max(initial=0))
+        self._shortest_us = int(self._interval_us.min(initial=0))
         self._all_due_us = 0
         """From this sim time on every ranger is due (the common step, told without an array per ranger)."""
+        self._next_due_us = 0
+        """Before this sim time no ranger is due (the steps between a slow laser's scans)."""
         self._every_ray = np.ones(len(self._owner), dtype=bool)
         self._stale = True
 
@@ -136,6 +123,7 @@ class RangerSensing:
         self.measured = previous.measured
         self._last_us = previous._last_us.copy()
         self._all_due_us = previous._all_due_us
+        self._next_due_us = previous._next_due_us
         self._stale = previous._stale
         self._rng = previous._rng
 
@@ -149,18 +137,17 @@ class RangerSensing:
         ``body_cells``: the robots' raster the rays see, (cell, robot)
         (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
-        all_due = self._stale or now_us >= self._all_due_us
-        self._stale = False
-        if all_due:
+        if self.all_due(time):
             due = None
-            self._last_us[:] = now_us
-            self._all_due_us = now_us + self._longest_us
+            self._mark_all_cast(now_us)
         else:
+            self._stale = False
             due = (now_us - self._last_us) >= self._interval_us
             if not due.any():
                 return
             self._last_us[due] = now_us
             self._all_due_us = int((self._last_us + self._interval_us).max())
+            self._next_due_us = int((self._last_us + self._interval_us).min())
         ray_due = None if due is None else due[self._ranger_of_ray]
         ranges = np.empty(len(self._owner))
         intensity = np.zeros(len(self._owner), dtype=np.float32)
@@ -177,8 +164,55 @@ class RangerSensing:
         noisy = self._apply_noise(ranges, self._every_ray if ray_due is None else ray_due) \
             if self._noisy else ranges
         published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
+        self._publish(range(len(self._rangers)) if due is None else np.flatnonzero(due), published, intensity, time)
         self.measured = MeasuredBeams(time, published, intensity, due, ray_due)
-        for k in (range(len(self._rangers)) if due is None else np.flatnonzero(due)):
+
+    def all_due(self, time: float) -> bool:
+        """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
+        return self._stale or round(time * 1e6) >= self._all_due_us
+
+    def none_due(self, time: float) -> bool:
+        """Whether no ranger is due at ``time`` (:meth:`sense` would cast nothing)."""
+        return not self._stale and round(time * 1e6) < self._next_due_us
+
+    def single_cast(self) -> SingleCast | None:
+        """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
+        it can: all rays at one height, a robot at least; else None (:meth:`sense` casts them)."""
+        if len(self._groups) != 1 or not self._bodies.count:
+            return None
+        jitter, _, _, noisy_rays, prop, _, uniform, gauss = self._all_cast
+        return SingleCast(self._groups[0], self._ranger_offset, self._ranger_owner, self._trig,
+                          float(self._max_range.max(initial=0.0)), jitter, noisy_rays, prop, uniform, gauss)
+
+    def draw_all_noise(self) -> None:
+        """Draw the noise of a cast of every ray into :meth:`single_cast`'s buffers, before a fused step casts
+        them: the draws :meth:`sense` makes for it, in its order (directions, then U', then G)."""
+        if not self._noisy:
+            return
+        jitter, jitter_rays, jitter_scale, noisy_rays, _, sqrt_const, uniform, gauss = self._all_cast
+        if jitter_rays.size:
+            jitter[jitter_rays] = jitter_scale * self._rng.uniform(-1.0, 1.0, len(jitter_rays))
+        if noisy_rays.size:
+            uniform[:] = self._rng.uniform(-1.0, 1.0, len(noisy_rays))
+            gauss[:] = self._rng.normal(0.0, 1.0, len(noisy_rays)) * sqrt_const
+
+    def record_all(self, published: np.ndarray, intensity: np.ndarray, time: float) -> None:
+        """Take the scans of every ranger cast at ``time`` by a fused step (when :meth:`all_due`): what
+        :meth:`sense` keeps of its own cast."""
+        self._mark_all_cast(round(time * 1e6))
+        self._publish(range(len(self._rangers)), published, intensity, time)
+        self.measured = MeasuredBeams(time, published, intensity, None, None)
+
+    def _mark_all_cast(self, now_us: int) -> None:
+        """Every ranger cast at ``now_us``: the next all-due step is a longest interval away."""
+        self._stale = False
+        self._last_us[:] = now_us
+        self._all_due_us = now_us + self._longest_us
+        self._next_due_us = now_us + self._shortest_us
+
+    def _publish(self, rangers: Iterable[int], published: np.ndarray, intensity: np.ndarray, time: float) -> None:
+        """New scans of ``rangers`` from the float32 ranges and intensities of all beams (views of their own)."""
+        for k in rangers:
             robot_index, ranger_index, part = self._scan_slots[k]
             scan = Scan(published[part], intensity[part], time)
             robot_scans = self.latest[robot_index]
@@ -188,7 +222,7 @@ class RangerSensing:
                 robot_scans.append(scan)
 
     def _cast(
-        self, group: _HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
+        self, group: HeightGroup, chosen: np.ndarray | None, poses: np.ndarray, origins: np.ndarray,
         jitter: np.ndarray | None, robot_cells: tuple[np.ndarray, np.ndarray] | None, ranges: np.ndarray,
         intensity: np.ndarray,
     ) -> None:
@@ -211,6 +245,19 @@ class RangerSensing:
         # a lone robot never sees itself
         self._backend.hit_intensity(cell, hit_robot, group.intensity, group.robot_return, self._bodies.count > 1,
                                     rays, intensity, self._grid.threads)
+
+    def _all_cast_noise(self) -> tuple[np.ndarray, ...]:
+        """What the noise of a cast of every ray needs, worked out as :meth:`_angle_jitter` and :meth:`_apply_noise`
+        work it out (the same arithmetic): the jitter (its buffer, rays and scale), the rays with a range noise,
+        their proportional noise and the square root of their constant one, buffers for U' and G."""
+        angle_noise = self._ray_noise[:, 2]
+        jitter_rays = np.flatnonzero(angle_noise != 0.0)
+        jitter_scale = self._increment[self._ranger_of_ray[jitter_rays]] * angle_noise[jitter_rays] / 2
+        noisy_rays = np.flatnonzero(np.any(self._ray_noise != 0.0, axis=1))
+        const, prop = self._ray_noise[noisy_rays, 0], self._ray_noise[noisy_rays, 1]
+        jitter = np.zeros(len(self._owner)) if self._angle_noisy else self._no_jitter
+        return (jitter, jitter_rays, jitter_scale, noisy_rays, prop, np.sqrt(const), np.empty(noisy_rays.size),
+                np.empty(noisy_rays.size))
 
     def _angle_jitter(self, ray_due: np.ndarray | None) -> np.ndarray:
         """Stage's beam-direction noise inc·a·U/2 for due beams (all when None) of rangers with an angle
@@ -250,7 +297,7 @@ class RangerSensing:
                                                              threads=self._grid.threads)
             caster = casters[id(occupied)]
             rays = np.flatnonzero(ray_height == height)
-            groups.append(_HeightGroup(
+            groups.append(HeightGroup(
                 rays=rays,
                 owner=self._owner[rays],
                 ranger=self._ranger_of_ray[rays],

@@ -120,6 +120,7 @@ class Simulation:
         self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(self._kernels_asked)
         self._collision, self._sensing = self.build_parts(self.kernels)
         self._motion = backend_for(self.kernels).motion
+        self._fused = backend_for(self.kernels).fused(self._collision, self._sensing.single_cast(), self.threads)
         note_kernels_running(self.kernels)
         self.warnings = list(self._world_warnings)
         for index in np.flatnonzero(self._collision.overlapping(self._start)):
@@ -209,8 +210,32 @@ class Simulation:
             silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
             self.commands[silent] = 0.0
         self.velocities = self._body_velocities()
-        moving = (self.velocities != 0.0).any(axis=1)
         layer = self._updates % 2
+        fused = self._fused is not None
+        cast = fused and self._sensing.all_due(self.sim_time)
+        if cast or (fused and self._sensing.none_due(self.sim_time)):  # a fused step casts all rangers or none
+            self._step_fused(layer, dt, cast)
+        else:
+            self._step_by_roles(layer, dt)
+        if self._upgrade is not None:
+            self._adopt(self._upgrade.poll())
+
+    def _step_fused(self, layer: int, dt: float, cast: bool) -> None:
+        """The moves, odometry and (when ``cast``) every ranger's scan of a step in few compiled calls, the same
+        as :meth:`_step_by_roles` gives (the backend's fused step)."""
+        if cast:
+            self._sensing.draw_all_noise()
+        fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
+                                 self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast)
+        self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
+            fused.poses, fused.stalled, fused.odometry, fused.layers
+        self._updates += 1
+        if cast:
+            self._sensing.record_all(*fused.scans, self.sim_time)
+
+    def _step_by_roles(self, layer: int, dt: float) -> None:
+        """The moves, odometry and scans of a step, one role after the other (what the fused step does at once)."""
+        moving = (self.velocities != 0.0).any(axis=1)
         moved, refused, layer_poses = self._collision.resolve(
             self.true_poses, self._layer_poses[layer], self.velocities, dt, moving)
         self._layer_poses = self._layer_poses.copy()
@@ -221,8 +246,6 @@ class Simulation:
         self.odometry_poses = self._odometry(moved, dt)
         # The rays read the layer just built (Stage's sensors of the next update read it), not the true poses.
         self._sensing.sense(self.true_poses, self.sim_time, self._collision.raster(layer_poses))
-        if self._upgrade is not None:
-            self._adopt(self._upgrade.poll())
 
     def wait_for_kernels(self, timeout: float | None = None) -> None:
         """Block until a background switch to the compiled kernels (if any is under way) is ready; the
@@ -236,6 +259,7 @@ class Simulation:
             return
         parts.sensing.adopt(self._sensing)
         self._collision, self._sensing, self._motion = parts.collision, parts.sensing, parts.backend.motion
+        self._fused = parts.fused
         self.kernels = parts.backend.name
         self._upgrade = None
 

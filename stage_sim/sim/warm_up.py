@@ -33,6 +33,10 @@ def warm() -> None:
     sim = Simulation(load_world_text(WORLD, "warm_up.world"), seed=0, kernels="numba")
     sim.set_velocity(0, 0.5, 0.0, 0.5)
     sim.step()
+    collision, sensing = sim.build_parts("numba")
+    fused = backend_for("numba").fused(collision, sensing.single_cast(), 1)
+    if fused is not None:  # its steps ran above; this also loads the cast into a grown robot layer
+        fused.warm(sim.start_poses)
     big_batch = np.zeros((4096, 2))  # large enough for the parallel loop
     backend_for("numba").caster(np.zeros((8, 8), dtype=bool), 0.1, (-0.4, -0.4), threads=2).cast(big_batch, 0.0, 1.0)
 

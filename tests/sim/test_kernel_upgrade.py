@@ -40,14 +40,20 @@ def frames(sim: Simulation, switch_at: int | None = None) -> tuple[list[tuple], 
     return out, used
 
 
-def test_unchosen_kernels_switch_to_numba_without_changing_the_run(numba_not_loaded):
-    world = load_world_text(crowd_world(2).replace("samples 271", "samples 91"), "crowd.world")
+@pytest.mark.parametrize("quiet", [False, True])
+def test_unchosen_kernels_switch_to_numba_without_changing_the_run(numba_not_loaded, quiet):
+    """``quiet``: without noise and low robots, the world numba steps fused once it has switched."""
+    text = crowd_world(2).replace("samples 271", "samples 91")
+    if quiet:
+        text = text.replace(" noise [0.0004 0.01 0.5]", "").replace(" size [0.4 0.3 0.05]", "")
+    world = load_world_text(text, "crowd.world")
     switching = Simulation(world, seed=2)
     assert switching.kernels == "numpy"
     switched, used = frames(switching, switch_at=10)
     switch = used.index("numba")
     assert 0 < switch <= 11 and used[switch:] == ["numba"] * (STEPS - switch)
     assert kernel_upgrade.numba_loaded()
+    assert (switching._fused is not None) == quiet
     reference, _ = frames(Simulation(world, seed=2, kernels="numpy"))
     assert switched == reference
 

@@ -4,6 +4,8 @@ The names live in :data:`stage_sim.worldfile.drive_names.DRIVE_NAMES` (world fil
 simulation); the model of drive ``name`` is the module ``stage_sim.sim.drives.<name>``, which declares:
 
 * ``HOLONOMIC``: whether it can move sideways (the wanderer then tries sideways commands too);
+* ``STEERED``: whether its compiled twin reads the cos and sin of the command's angle (the others get none, and
+  a step computes none for them);
 * ``velocities(commands, wheelbases)``: the numpy reference, body velocities (vx, vy, va) for commands
   (gx, gy, ga) before ``velocity_bounds`` clamp them;
 * ``compiled_velocities(commands, rows, wheelbases, cos_steer, sin_steer, out)``: its twin for numba, the same
@@ -32,13 +34,14 @@ class Drive:
 
     name: str
     holonomic: bool
+    steered: bool
     velocities: Callable[[np.ndarray, np.ndarray], np.ndarray]
     compiled_velocities: Callable[..., None]
 
 
 def _load(name: str) -> Drive:
     module = import_module(f"{__name__}.{name}")
-    return Drive(name, module.HOLONOMIC, module.velocities, module.compiled_velocities)
+    return Drive(name, module.HOLONOMIC, module.STEERED, module.velocities, module.compiled_velocities)
 
 
 DRIVES: dict[str, Drive] = {name: _load(name) for name in DRIVE_NAMES}

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 HOLONOMIC = False
+STEERED = True
 
 
 def velocities(commands: np.ndarray, wheelbases: np.ndarray) -> np.ndarray:

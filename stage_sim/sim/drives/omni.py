@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 HOLONOMIC = True
+STEERED = False
 
 
 def velocities(commands: np.ndarray, wheelbases: np.ndarray) -> np.ndarray:

@@ -1,0 +1,270 @@
+"""Compiled (numba) step in two calls: the end poses and odometry, then the contacts and every laser's cast.
+
+Why: for one robot a step of the compiled backend made some sixty calls (kernels, numpy, Python), which
+cost twice the ray walk itself. Here each part of a step is one call of the existing kernels
+(:mod:`stage_sim.sim.body_kernels`, :mod:`stage_sim.sim.motion_kernels`, :mod:`stage_sim.sensing.robot_kernels`,
+:mod:`stage_sim.sensing.traversal`, :mod:`stage_sim.sim.ranger_kernels`) in the order and with the arguments
+the role-by-role step gives them, so every pose, flag, range and intensity is the same bit for bit
+(``tests/sim/test_step_digests.py``, ``tests/sim/test_kernel_identity.py``). The trigonometry stays in numpy:
+the caller passes the cosines and sines of every heading the kernels place a point with, computed once per
+heading: a step's new headings are the next one's start (remembered, and checked bit for bit before use).
+
+What never changes between two steps of a world (bodies, static layers, beam tables, scratch arrays) travels
+in one :class:`FusedWorld`: numba checks the type of every argument of every call, some 0.1 µs an array, and
+a step reads some sixty arrays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numba.core import types
+from numba.experimental import structref
+
+from stage_sim.sensing import robot_kernels, traversal
+from stage_sim.sim import body_kernels, motion_kernels, ranger_kernels
+
+_JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+#: What a :class:`FusedWorld` holds, in the order :func:`fused_world` takes it.
+FIELDS = (
+    # bodies and contacts: polygons, radii, (col0, row0, height, width, static width), cells per metre
+    "vertices", "poly_start", "robot_poly", "radius", "grid", "ppm", "collides", "colliding", "can_clash",
+    # the static cells of the one height band: slots, tiles, bits, place
+    "slots", "tile_of_slot", "bits", "static_place",
+    # the rangers and the robot layer: tables (regions, ids, row and column masks, used lines, owner), its room
+    "ranger_offset", "ranger_owner", "robots_seen", "visible", "regions", "ids", "rows", "cols", "rows_used",
+    "cols_used", "tile_owner", "capacity", "region_place", "width", "marked_value", "several",
+    # the walk: the static layer's masks, tiles, slots and used lines, place, stop map and margin
+    "walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used", "walk_place", "stops",
+    "pad", "walk_ppm",
+    # the rays: ranger, angle, range, robot, slot, last angle, cos and sin
+    "ranger", "angle", "rmax", "owner", "rays", "last_angle", "last_cos", "last_sin",
+    # noise, drawn before each cast: direction (empty: none); rays with a range noise, their p, U' and G
+    "jitter", "noisy_rays", "noise_prop", "noise_uniform", "noise_gauss",
+    # intensities: static cells and values, robots' returns, the return of a cell two robots share
+    "static_cells", "static_values", "robot_return", "several_return",
+    # scratch: ranges, hit cells and robots; new headings, the remembered ones and their cos and sin
+    "ranges", "cell", "hit_robot", "headings", "known", "known_trig",
+)
+
+
+@structref.register
+class FusedWorldType(types.StructRef):
+    """numba's type of a :class:`FusedWorld`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class FusedWorld(structref.StructRefProxy):
+    """What a fused step of one world reads besides the robots' state (:data:`FIELDS`), as one argument."""
+
+
+structref.define_proxy(FusedWorld, FusedWorldType, list(FIELDS))
+
+
+@numba.njit(**_JIT)
+def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
+                tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids, rows,
+                cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value, several,
+                walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used, walk_place, stops, pad,
+                walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin, jitter, noisy_rays,
+                noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return, several_return,
+                ranges, cell, hit_robot, headings, known, known_trig):
+    """A :class:`FusedWorld` of the :data:`FIELDS` (compiled and cached: the proxy's own constructor is not)."""
+    return FusedWorld(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
+                      tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions,
+                      ids, rows, cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value,
+                      several, walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used,
+                      walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos,
+                      last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells,
+                      static_values, robot_return, several_return, ranges, cell, hit_robot, headings, known,
+                      known_trig)
+
+
+@numba.njit(**_JIT)
+def _boxes(poses, radius, ppm):
+    """:meth:`~stage_sim.sim.compiled.CompiledCollisionChecker._boxes`, the same arithmetic."""
+    box = np.empty((poses.shape[0], 4), dtype=np.int64)
+    for r in range(poses.shape[0]):
+        for axis in range(2):
+            box[r, axis] = np.int64(math.floor((poses[r, axis] - radius[r]) * ppm) - 1.0)
+            box[r, 2 + axis] = np.int64(math.floor((poses[r, axis] + radius[r]) * ppm) + 1.0)
+    return box
+
+
+@numba.njit(**_JIT)
+def _raster(world, robots, poses, cos, sin):
+    """:func:`~stage_sim.sim.body_kernels.body_raster` of ``robots`` at ``poses`` facing (``cos``, ``sin``)."""
+    grid = world.grid
+    return body_kernels.body_raster(world.vertices, world.poly_start, world.robot_poly, robots,
+                                    np.ascontiguousarray(poses[:, 0]), np.ascontiguousarray(poses[:, 1]), cos, sin,
+                                    world.ppm, grid[0], grid[1], grid[2], grid[3])
+
+
+@numba.njit(inline="always", **_JIT)
+def _same(a, b):
+    """Whether two floats have the same bits (NaN aside, which matches nothing): a cached heading's."""
+    return a == b and math.copysign(1.0, a) == math.copysign(1.0, b)
+
+
+@numba.njit(**_JIT)
+def advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known, known_trig, check, integrated,
+            odometry, headings):
+    """The end poses of every robot (:func:`~stage_sim.sim.motion_kernels.integrate_poses`) into ``integrated``
+    and the odometry of the robots that ``uses_odom`` (:func:`~stage_sim.sim.motion_kernels.integrate_estimates`)
+    into ``odometry``, with the cos and sin of their start headings remembered from the last step; their new
+    headings into ``headings[:, 2]`` (end poses, then odometry), whose cos and sin the step needs next.
+
+    ``known`` (4, N): the headings whose numpy cos and sin ``known_trig`` (4, 2, N) holds, of the poses, the
+    odometry and layers 0 and 1 (a :class:`FusedWorld`'s, given apart: fewer arguments to check than the world).
+    With ``check``, returns False (and does nothing) unless they are the headings of ``poses``, ``estimates``
+    and ``layers[layer]`` bit for bit (a reset or a pose set between steps)."""
+    n = poses.shape[0]
+    if check:
+        for i in range(n):
+            if not (_same(poses[i, 2], known[0, i]) and _same(estimates[i, 2], known[1, i])
+                    and _same(layers[layer, i, 2], known[2 + layer, i])):
+                return False
+    motion_kernels.integrate_poses(poses, velocities, dt, known_trig[0, 0], known_trig[0, 1], integrated)
+    motion_kernels.integrate_estimates(estimates, velocities, errors, dt, known_trig[1, 0], known_trig[1, 1],
+                                       uses_odom, estimates, odometry)
+    for i in range(n):
+        headings[i, 2] = integrated[i, 2]
+        headings[n + i, 2] = odometry[i, 2]
+    return True
+
+
+@numba.njit(**_JIT)
+def step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
+         stalled_out, final_trig, cast, old_marked, active, published, intensity):
+    """The rest of a step after :func:`advance`: Stage's moves in layer ``layer`` of ``layers`` (2, N, 3), as
+    :meth:`~stage_sim.sim.collision.CollisionChecker.resolve` and the simulation's step make them, then every
+    ray (:func:`sense`) from the new poses, through the robots where the layer now holds them, when ``cast``.
+
+    The robots with a velocity go to their end poses (``integrated``, whose headings' cos and sin are
+    ``end_trig`` (2, 2N)) unless a cell of theirs there is a static cell of their height band or, when
+    ``world.can_clash``, one of another obstacle robot as the layer holds it when they move (one by one, in
+    robot order). Writes the new poses, stall flags and their cos and sin into ``final``, ``stalled_out`` and
+    ``final_trig``, the layer's new poses into ``layers[layer]``, the true pose as odometry of the robots
+    without ``uses_odom``, and what ``world.known`` and ``world.known_trig`` hold for the next step
+    (:func:`advance`). Returns the raster the rays saw and :func:`sense`'s answer (without a cast: the moves'
+    raster and the layer's state as given)."""
+    n = poses.shape[0]
+    known, known_trig, collides = world.known, world.known_trig, world.collides  # locals: each read of a field
+    layer_poses = layers[layer].copy()  # counts a reference
+    moving = np.zeros(n, dtype=np.bool_)
+    candidates = poses.copy()
+    testers = np.empty(n, dtype=np.int64)
+    count = 0
+    for i in range(n):
+        moving[i] = velocities[i, 0] != 0.0 or velocities[i, 1] != 0.0 or velocities[i, 2] != 0.0
+        if moving[i]:
+            candidates[i] = integrated[i]
+            if collides[i]:
+                testers[count] = i
+                count += 1
+    testers = testers[:count]
+    refused = np.zeros(n, dtype=np.bool_)
+    start_cos, start_sin = known_trig[0, 0].copy(), known_trig[0, 1].copy()
+    end_cos, end_sin = end_trig[0, :n].copy(), end_trig[1, :n].copy()
+    row = 2 + layer
+    end_cells, end_robot = np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    if count:
+        end_cells, end_robot = _raster(world, testers, candidates, end_cos, end_sin)
+        static_hit = np.zeros(n, dtype=np.bool_)
+        body_kernels.static_hits(end_cells, end_robot, np.zeros(n, dtype=np.int64), 0, world.slots,
+                                 world.tile_of_slot, world.bits, world.static_place, world.grid[4], static_hit)
+        if world.can_clash:
+            before = _raster(world, world.colliding, layer_poses, known_trig[row, 0], known_trig[row, 1])
+            back = _raster(world, testers, poses, start_cos, start_sin)
+            box = np.empty((3, n, 4), dtype=np.int64)
+            box[0] = _boxes(layer_poses, world.radius, world.ppm)
+            box[1] = _boxes(candidates, world.radius, world.ppm)
+            box[2] = _boxes(poses, world.radius, world.ppm)
+            body_kernels.move_one_by_one(testers, static_hit, end_cells, end_robot, before[0], before[1], back[0],
+                                         back[1], world.colliding, box, refused)
+        else:
+            for k in range(count):
+                refused[testers[k]] = static_hit[testers[k]]
+    for i in range(n):
+        accepted = moving[i] and not refused[i]
+        for axis in range(3):
+            final[i, axis] = candidates[i, axis] if accepted else poses[i, axis]
+        final_trig[0, i] = end_cos[i] if accepted else start_cos[i]
+        final_trig[1, i] = end_sin[i] if accepted else start_sin[i]
+        stalled_out[i] = refused[i] if moving[i] else stalled[i]
+        if moving[i]:
+            for axis in range(3):
+                layers[layer, i, axis] = final[i, axis]
+            known[row, i] = final[i, 2]
+            known_trig[row, 0, i], known_trig[row, 1, i] = final_trig[0, i], final_trig[1, i]
+        known[0, i] = final[i, 2]
+        known_trig[0, 0, i], known_trig[0, 1, i] = final_trig[0, i], final_trig[1, i]
+        if uses_odom[i]:
+            known_trig[1, 0, i], known_trig[1, 1, i] = end_trig[0, n + i], end_trig[1, n + i]
+        else:  # gps: the odometry is the true pose
+            for axis in range(3):
+                odometry[i, axis] = final[i, axis]
+            known_trig[1, 0, i], known_trig[1, 1, i] = final_trig[0, i], final_trig[1, i]
+        known[1, i] = odometry[i, 2]
+    if not cast:
+        return end_cells, end_robot, old_marked, 0, active
+    if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
+        cells, cell_robot = end_cells, end_robot
+    else:
+        cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
+    marked, tiles, active = sense(world, final, final_trig, cells, cell_robot, old_marked, active, published,
+                                  intensity)
+    return cells, cell_robot, marked, tiles, active
+
+
+@numba.njit(**_JIT)
+def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, intensity):
+    """Every ray of one height cast from ``poses`` (their cos and sin ``trig``, (2, N)) as
+    :meth:`~stage_sim.sim.rangers.RangerSensing.sense` casts them when all rangers are due: the rangers'
+    origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; ``old_marked``, ``active``: the
+    layer's regions marked and whether it holds a cell), the walk (with the direction noise drawn), the
+    intensities, the range noise drawn (r + r·p·U' + G for a hit), the float32 ranges.
+
+    With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
+    layer's tiles, else their regions are only marked. Returns (regions marked, tiles needed, whether the
+    layer holds a cell); when the layer has room for fewer tiles than needed (``world.capacity``) nothing is
+    cast: the caller grows it and calls again."""
+    w = world
+    origins = np.empty((w.ranger_offset.shape[0], 2))
+    motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)
+    if w.robots_seen:
+        marked, tile, local, count = robot_kernels.number_robot_regions(
+            w.regions, old_marked, cells, cell_robot, w.visible, w.region_place, w.width, w.marked_value)
+        if count > w.capacity:
+            return marked, count, active
+        active = robot_kernels.write_robot_tiles(w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner, tile,
+                                                 local, cell_robot.astype(np.int32), count, w.several)
+    else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
+        marked = robot_kernels.number_robot_regions(
+            w.regions, old_marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=np.bool_),
+            w.region_place, w.width, w.marked_value)[0]
+        count = 0
+    ranger_owner, ranges = w.ranger_owner, w.ranges  # locals: each read of a field counts a reference
+    heading = np.empty(ranger_owner.size)
+    for k in range(ranger_owner.size):
+        heading[k] = poses[ranger_owner[k], 2]
+    traversal.cast_serial(
+        (w.walk_rows, w.walk_cols, w.walk_tiles, w.walk_slots, w.walk_rows_used, w.walk_cols_used),
+        (w.regions, w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner), (True, active), w.walk_place,
+        w.stops, w.pad, marked, origins, w.ranger, heading, w.angle, w.jitter, (w.last_angle, w.last_cos, w.last_sin),
+        w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
+    ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
+                                 w.several, w.several_return, w.rays, intensity)
+    noisy_rays, rmax, prop, uniform, gauss = w.noisy_rays, w.rmax, w.noise_prop, w.noise_uniform, w.noise_gauss
+    for k in range(noisy_rays.size):
+        i = noisy_rays[k]
+        if ranges[i] < rmax[i]:
+            ranges[i] = ranges[i] + ranges[i] * prop[k] * uniform[k] + gauss[k]
+    for i in range(ranges.size):
+        published[i] = np.float32(ranges[i])
+    return marked, count, active
