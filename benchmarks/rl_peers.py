@@ -7,9 +7,10 @@ The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-bea
 * ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
   obstacles scenario; episodes that end are reset (resets count in the time);
 * ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env);
-* ``stage_sim rays``: the floor under both, Stage's ray walk alone: the same core run, but the rate counts only
-  the seconds spent in the compiled ray walk (its calls timed one by one), so it says how fast any step that
-  casts these lidars the way Stage does could be on this core;
+* ``stage_sim rays``: the floor under both, Stage's ray walk alone: the same core run, each step's lidars cast
+  once more by the world's role-by-role sensing, and the rate counts only the seconds spent in that compiled
+  ray walk (its calls timed one by one), so it says how fast any step that casts these lidars the way Stage
+  does could be on this core;
 * ``navground env`` / ``navground world``: navground 0.7 through navground-learning's Gymnasium env (1
   robot) or shared parallel env (10, 100), and its bare ``World`` (commands set, ``actuate``, every
   agent's lidar updated);
@@ -168,12 +169,15 @@ class StageCore(StageEnv):
 
 
 class StageRays(StageCore):
-    """The core run with the compiled ray walk's calls timed: the rate of the rays alone."""
+    """The core run, and after each step every lidar cast again by the role-by-role sensing of the same world
+    (the fused step walks inside one compiled call), its compiled ray walk's calls timed: the rate of the rays
+    alone."""
 
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.sensing import traversal
 
         super().__init__(robots, seed)
+        _, self.sensing = self.sim.build_parts("numba")
         self.ray_seconds = 0.0
         for name in ("cast_serial", "cast_parallel"):
             setattr(traversal, name, self._timed(getattr(traversal, name)))
@@ -186,6 +190,12 @@ class StageRays(StageCore):
             finally:
                 self.ray_seconds += time.perf_counter() - start
         return timed
+
+    def step(self, action: np.ndarray) -> int:
+        live = super().step(action)
+        self.sensing.invalidate()  # every lidar due, as in the core's steps
+        self.sensing.sense(self.sim.true_poses, self.sim.sim_time)
+        return live
 
     def start_timing(self) -> None:
         self.ray_seconds = 0.0
