@@ -1,17 +1,19 @@
 """What recording a bag costs: ``stage_sim run ... --speedup 0`` with and without ``--bag``, and scans recorded
 per wall second for 1 and 100 robots.
 
-Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 600] [--robots 1 100]``. Each
+Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 6000] [--robots 1 100]``. Each
 case runs the console script in its own process (as users run it) and reads the sim and wall time it prints;
 one JSON object per line:
 
-- ``overhead``: rooms.world with one robot driven straight and by the wanderer for ``--duration`` sim seconds,
-  and 100 robots for ``--crowd-duration``, plain and with ``--bag``, ``--repeat`` times each (interleaved; the
-  best counts, as the machine is shared): sim seconds per wall second of each and ``cost_pct``, how much
-  slower the recording run is (the target: <= 15); ``cpu_cost_pct``, the same from the CPU seconds of the
-  processes (the simulator and its bag writer), which the load of other processes disturbs less;
-  ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports, loading the
-  world, and with a bag starting its writer process), which the rates leave out.
+Every run steps on the compiled kernels from its first step (``STAGE_SIM_KERNELS=numba``).
+
+- ``overhead``: rooms.world with one robot driven straight for ``--duration`` sim seconds and by the wanderer
+  for ``--wander-duration``, and 100 robots for ``--crowd-duration``, plain and with ``--bag``, ``--repeat``
+  times each (interleaved; the best counts, as the machine is shared): sim seconds per wall second of each and
+  ``cost_pct``, how much slower the recording run is (the target: <= 15); ``cpu_cost_pct``, the same from the
+  CPU seconds of the processes (the simulator and its bag writer), which the load of other processes disturbs
+  less; ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports,
+  loading the world, and with a bag starting its writer process), which the rates leave out.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
   LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
 """
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import resource
 import subprocess
@@ -47,7 +50,10 @@ def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict
         command += ["--bag", str(bag)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.monotonic()
-    result = subprocess.run(command, capture_output=True, text=True, check=True)
+    # The compiled kernels from the first step: a run of a few wall seconds would otherwise spend most of them
+    # on numpy while numba loads in the background, and measure that.
+    result = subprocess.run(command, capture_output=True, text=True, check=True,
+                            env={**os.environ, "STAGE_SIM_KERNELS": "numba"})
     process_s = time.monotonic() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     sim_s, wall_s = map(float, RATE.search(result.stdout).groups())
@@ -88,7 +94,10 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=600.0, help="sim seconds of the one-robot overhead runs")
+    parser.add_argument("--duration", type=float, default=6000.0,
+                        help="sim seconds of the one-robot overhead runs driven straight (a few wall seconds)")
+    parser.add_argument("--wander-duration", type=float, default=600.0,
+                        help="sim seconds of the one-robot overhead runs driven by the wanderer")
     parser.add_argument("--crowd-duration", type=float, default=60.0,
                         help="sim seconds of the 100-robot overhead runs")
     parser.add_argument("--repeat", type=int, default=3, help="overhead runs of each kind (best one counts)")
@@ -102,7 +111,7 @@ def main() -> None:
         crowd = tmp / "robots_100.world"
         crowd.write_text(world_text(100, 240, 240.0, 5.6, seed=1))
         for world, robots, controller, duration in ((rooms, 1, "straight", args.duration),
-                                                    (rooms, 1, "wander", args.duration),
+                                                    (rooms, 1, "wander", args.wander_duration),
                                                     (crowd, 100, "straight", args.crowd_duration)):
             print(json.dumps(overhead(world, robots, controller, duration, args.repeat, tmp / "overhead.mcap")),
                   flush=True)
