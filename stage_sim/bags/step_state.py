@@ -133,9 +133,9 @@ class _Array(_Column):
 
 
 class _Tuple(_Column):
-    """A tuple of values (odometry: poses and velocities)."""
+    """A tuple of array values (odometry: poses and velocities)."""
 
-    def __init__(self, parts: list[_Column]) -> None:
+    def __init__(self, parts: list[_Array]) -> None:
         self.parts = parts
 
     def empty(self, size: int) -> _Tuple:
@@ -143,7 +143,7 @@ class _Tuple(_Column):
 
     def put(self, k: int, value: tuple) -> None:
         for part, item in zip(self.parts, value, strict=True):
-            part.put(k, item)
+            part.data[k] = item  # _Array.put, inlined: this runs every step
 
     def row(self, k: int) -> tuple:
         return tuple(part.row(k) for part in self.parts)
@@ -199,7 +199,7 @@ class _Scans(_Column):
 def _column(value: Any, sim: Simulation) -> _Column:
     """The column for a topic's values, shaped after one step's ``value``."""
     if isinstance(value, tuple):
-        return _Tuple([_column(item, sim) for item in value])
+        return _Tuple([_Array.like(item) for item in value])
     if isinstance(value, fields.LatestScans):
         counts = [len(robot.rangers) for robot in sim.robots]
         first = tuple(int(i) for i in np.concatenate([[0], np.cumsum(counts)]))
