@@ -4,13 +4,13 @@ The stepping side copies each step into a :class:`StepBatch`, column by column (
 value of a per-step topic, a row per step), and sends the batch whole: a step costs it a few array copies, and
 pickling a batch a few arrays however many steps it holds (a step's values pickled one by one cost about as
 much as simulating a one-robot step). The writer reads each topic's values for all the batch's steps at once
-(:meth:`StepBatch.values`), or step by step (:class:`StepState`).
+(:meth:`StepBatch.values`).
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -70,16 +70,6 @@ class ScanRows:
         return PackedScans(self.first, offsets, self.lengths, self.ranges[k], self.intensities[k])
 
 
-@dataclass(frozen=True)
-class StepState:
-    """What one step published: its sim time and the values (:attr:`Topic.values`) of the recorded per-step
-    topics, in their order (a list, not a dict by topic: hashing a Topic, a dataclass of enums, per step cost
-    more than the rest)."""
-
-    sim_time_us: int
-    values: list[Any]
-
-
 class _Column(ABC):
     """One value of a per-step topic, for the steps of a batch: a row per step."""
 
@@ -90,10 +80,6 @@ class _Column(ABC):
     @abstractmethod
     def put(self, k: int, value: Any) -> None:
         """Copy step ``k``'s value."""
-
-    @abstractmethod
-    def row(self, k: int) -> Any:
-        """Step ``k``'s value."""
 
     @abstractmethod
     def rows(self, count: int) -> Any:
@@ -122,9 +108,6 @@ class _Array(_Column):
     def put(self, k: int, value: Any) -> None:
         self.data[k] = value
 
-    def row(self, k: int) -> Any:
-        return self.data[k] if self.data.ndim > 1 else self.data[k].item()
-
     def rows(self, count: int) -> np.ndarray:
         return self.data[:count]
 
@@ -144,9 +127,6 @@ class _Tuple(_Column):
     def put(self, k: int, value: tuple) -> None:
         for part, item in zip(self.parts, value, strict=True):
             part.data[k] = item  # _Array.put, inlined: this runs every step
-
-    def row(self, k: int) -> tuple:
-        return tuple(part.row(k) for part in self.parts)
 
     def rows(self, count: int) -> tuple:
         return tuple(part.rows(count) for part in self.parts)
@@ -181,9 +161,6 @@ class _Scans(_Column):
             taken = int(np.count_nonzero(beams.ray_due))
             self.ranges[k, :taken], self.intensities[k, :taken] = beams.ranges[beams.ray_due], \
                 beams.intensities[beams.ray_due]
-
-    def row(self, k: int) -> PackedScans:
-        return self.rows(k + 1).row(k)
 
     def rows(self, count: int) -> ScanRows:
         return ScanRows(self.first, self.lengths, self.ranges[:count], self.intensities[:count],
@@ -249,11 +226,6 @@ class StepBatch:
     def values(self) -> list[Any]:
         """Each topic's values for all the steps held (a leading axis per step), in the topics' order."""
         return [column.rows(self.count) for column in self._columns]
-
-    def steps(self) -> Iterator[StepState]:
-        """The steps held, in order, one by one."""
-        for k in range(self.count):
-            yield StepState(self._times.row(k), [column.row(k) for column in self._columns])
 
     def __getstate__(self) -> dict[str, Any]:
         """Only the rows filled travel to the writer."""

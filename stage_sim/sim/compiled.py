@@ -88,10 +88,9 @@ class CompiledMotion:
                         ) -> np.ndarray:
         out = np.empty_like(commands)
         cos_steer = sin_steer = _UNSTEERED
-        for group in drives:
-            if group.drive.steered:
-                steer = commands[:, 2]
-                cos_steer, sin_steer = np.cos(steer), np.sin(steer)
+        if any(group.drive.steered for group in drives):
+            steer = commands[:, 2]
+            cos_steer, sin_steer = np.cos(steer), np.sin(steer)
         motion_kernels.body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out)
         return out
 

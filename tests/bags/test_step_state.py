@@ -45,17 +45,19 @@ def test_a_pickled_batch_gives_back_every_step(tmp_path) -> None:
                  for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
     assert not batch.full
-    steps = list(pickle.loads(pickle.dumps(batch)).steps())
-    assert len(steps) == 7
+    received = pickle.loads(pickle.dumps(batch))
+    assert received.count == 7
+    values = dict(zip(STEPPED, received.values(), strict=True))
+    np.testing.assert_array_equal(received.times, [time_us for time_us, *_ in expected])
+    np.testing.assert_array_equal(values[topics.CLOCK], received.times)
     skipped = 0
-    for state, (time_us, odometry, velocities, scans) in zip(steps, expected, strict=True):
-        values = dict(zip(STEPPED, state.values, strict=True))
-        assert state.sim_time_us == time_us and values[topics.CLOCK] == time_us
-        np.testing.assert_array_equal(values[topics.ODOM][0], odometry)
-        np.testing.assert_array_equal(values[topics.GROUND_TRUTH][1], velocities)
-        np.testing.assert_array_equal(values[topics.TF], odometry)
+    for k, (_, odometry, velocities, scans) in enumerate(expected):
+        np.testing.assert_array_equal(values[topics.ODOM][0][k], odometry)
+        np.testing.assert_array_equal(values[topics.GROUND_TRUTH][1][k], velocities)
+        np.testing.assert_array_equal(values[topics.TF][k], odometry)
+        step_scans = values[topics.SCAN].row(k)
         for (robot, ranger), scan in scans.items():
-            packed = values[topics.SCAN].measured(robot, ranger)
+            packed = step_scans.measured(robot, ranger)
             if scan is None:
                 assert packed is None
                 skipped += 1
