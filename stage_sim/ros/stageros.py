@@ -127,16 +127,13 @@ class StageRos(Node):
 
     def _create_interfaces(self, stamped: bool) -> None:
         """A publisher per endpoint of every published topic, its message built once (publishing serialises,
-        so refilling is safe), a subscription per endpoint of every subscribed topic, and the reset service."""
+        so refilling is safe), a subscription per endpoint of every subscribed topic, and the reset service.
+        Publishers come first: Fast DDS creates an endpoint in time growing with the participant's endpoints,
+        and 3000 writers then 1000 readers cost a quarter less CPU than the other way round (1000 robots)."""
         handlers: dict[Topic, Callable[[int, Any], None]] = {
             topics.CMD_VEL: self.on_command,
             topics.CMD_VEL_STAMPED: lambda robot, msg: self.on_command(robot, msg.twist),
         }
-        for topic in topics.subscribed(stamped):
-            for endpoint in topics.endpoints(topic, self.names):
-                self.create_subscription(
-                    message_class(topic), endpoint.name, lambda msg, i=endpoint.robot, h=handlers[topic]: h(i, msg),
-                    qos_profile(topic.qos), event_callbacks=NO_SUB_EVENTS)
         self.publishers_by_name: dict[str, Publisher] = {}
         self._channels: list[_Channel] = []
         for topic in topics.published(self.publish_map):
@@ -148,6 +145,11 @@ class StageRos(Node):
                 self.publishers_by_name[endpoint.name] = publisher
                 outlets.append((publisher, TOPIC_MESSAGES[topic].build(endpoint, self.sim, self.names), endpoint))
             self._channels.append(_Channel(topic, TOPIC_MESSAGES[topic].fill, outlets))
+        for topic in topics.subscribed(stamped):
+            for endpoint in topics.endpoints(topic, self.names):
+                self.create_subscription(
+                    message_class(topic), endpoint.name, lambda msg, i=endpoint.robot, h=handlers[topic]: h(i, msg),
+                    qos_profile(topic.qos), event_callbacks=NO_SUB_EVENTS)
         self._stepped = [channel for channel in self._channels if channel.topic.timing is not Timing.START]
         self.create_service(Empty, topics.RESET_POSITIONS, self.on_reset,
                             qos_profile=qos_profile(qos.EVERY_REQUEST))

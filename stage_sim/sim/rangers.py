@@ -149,7 +149,7 @@ class RangerSensing:
             self._all_due_us = int((self._last_us + self._interval_us).max())
             self._next_due_us = int((self._last_us + self._interval_us).min())
         ray_due = None if due is None else due[self._ranger_of_ray]
-        ranges = np.empty(len(self._owner))
+        ranges = np.zeros(len(self._owner))  # rays not due keep 0, never garbage that overflows float32
         intensity = np.zeros(len(self._owner), dtype=np.float32)
         # Even a lone robot's cells count: they make Stage's regions around it non-empty (sensing/stage_walk.py).
         robot_cells = None
