@@ -6,7 +6,10 @@ The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-bea
 
 * ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
   obstacles scenario; episodes that end are reset (resets count in the time);
-* ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env);
+* ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env), only that
+  timed; the world is reset through the env (untimed) when the env would end the episode (every robot has
+  collided, or the step limit), so that the core steps robots in open space as the env's do, not resting
+  against a wall with short rays;
 * ``stage_sim rays``: the floor under both, Stage's ray walk alone: the same core run, each step's lidars cast
   once more by the world's role-by-role sensing, and the rate counts only the seconds spent in that compiled
   ray walk (its calls timed one by one), so it says how fast any step that casts these lidars the way Stage
@@ -31,6 +34,7 @@ ahead of another must show in the middle beam of its scan.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -38,7 +42,7 @@ import shutil
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -155,17 +159,48 @@ class StageEnv(EnvRunner):
 
 
 class StageCore(StageEnv):
-    """The env's world, stepped by ``Simulation.step`` alone: commands written into its array, one step."""
+    """The env's world stepped by ``Simulation.step`` alone (commands written into its array, one step, only
+    those timed), through the env's episodes: once every robot has collided or the env's step limit is reached,
+    the env resets the world (not timed). Without that the robots soon rest against walls with their rays
+    short, and the core would be timed on cheaper steps than the env takes."""
 
     def __init__(self, robots: int, seed: int) -> None:
         super().__init__(robots, seed)
+        self.max_steps = self.env.task.config.max_steps
+        self.timed = 0.0
+        self.new_episode()
+
+    def new_episode(self) -> None:
+        """Take the world the env has just reset (the obstacles scenario makes a new one each episode)."""
         self.sim = self.env.task.sim
+        self.ended = np.zeros(len(self.sim.robots), dtype=bool)
+        self.episode_steps = 0
 
     def step(self, action: np.ndarray) -> int:
+        start = time.perf_counter()
         self.sim.commands[:, 0] = action[:, 0]
         self.sim.commands[:, 2] = action[:, 1]
         self.sim.step()
+        self.timed += time.perf_counter() - start
+        self.after_step()
+        self.ended |= self.sim.stalled
+        self.episode_steps += 1
+        if self.ended.all() or self.episode_steps >= self.max_steps:
+            self.next_episode()
         return len(action)
+
+    def next_episode(self) -> None:
+        self.env.reset()
+        self.new_episode()
+
+    def after_step(self) -> None:
+        """What a subclass measures of each step, before an episode's end may reset the world."""
+
+    def start_timing(self) -> None:
+        self.timed = 0.0
+
+    def timed_seconds(self, wall: float) -> float:
+        return self.timed
 
 
 class StageRays(StageCore):
@@ -176,11 +211,29 @@ class StageRays(StageCore):
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.sensing import traversal
 
-        super().__init__(robots, seed)
-        _, self.sensing = self.sim.build_parts("numba")
         self.ray_seconds = 0.0
-        for name in ("cast_serial", "cast_parallel"):
-            setattr(traversal, name, self._timed(getattr(traversal, name)))
+        self.kernels = {name: getattr(traversal, name) for name in ("cast_serial", "cast_parallel")}
+        super().__init__(robots, seed)
+
+    @contextlib.contextmanager
+    def bare_kernels(self) -> Iterator[None]:
+        """The ray walk's own kernels while worlds are built (building checks their signatures), then timed."""
+        from stage_sim.sensing import traversal
+
+        for name, kernel in self.kernels.items():
+            setattr(traversal, name, kernel)
+        yield
+        for name, kernel in self.kernels.items():
+            setattr(traversal, name, self._timed(kernel))
+
+    def new_episode(self) -> None:
+        with self.bare_kernels():
+            super().new_episode()
+            _, self.sensing = self.sim.build_parts("numba")
+
+    def next_episode(self) -> None:
+        with self.bare_kernels():
+            super().next_episode()
 
     def _timed(self, kernel: Callable[..., Any]) -> Callable[..., Any]:
         def timed(*args: Any) -> Any:
@@ -191,11 +244,9 @@ class StageRays(StageCore):
                 self.ray_seconds += time.perf_counter() - start
         return timed
 
-    def step(self, action: np.ndarray) -> int:
-        live = super().step(action)
+    def after_step(self) -> None:
         self.sensing.invalidate()  # every lidar due, as in the core's steps
         self.sensing.sense(self.sim.true_poses, self.sim.sim_time)
-        return live
 
     def start_timing(self) -> None:
         self.ray_seconds = 0.0
