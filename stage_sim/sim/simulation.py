@@ -165,6 +165,7 @@ class Simulation:
         self.stalled = np.zeros(n, dtype=bool)
         self._layer_poses = np.stack([self._start, self._start])  # where each of Stage's two layers has them
         self.last_command_us = np.full(n, self.sim_time_us, dtype=np.int64)
+        self._oldest_command_us = self.sim_time_us
         self.odometry_poses = np.where(
             self._uses_odom[:, None], relative_pose(self._start, self._odom_origin), self._start)
         self._sensing.invalidate()
@@ -207,8 +208,7 @@ class Simulation:
         self.sim_time_us += self.interval_us
         dt = self.interval_us / MICROSECONDS
         if self.watchdog_timeout > 0:
-            silent = (self.sim_time_us - self.last_command_us) >= round(self.watchdog_timeout * MICROSECONDS)
-            self.commands[silent] = 0.0
+            self._stop_silent_robots()
         self.velocities = self._body_velocities()
         layer = self._updates % 2
         fused = self._fused is not None
@@ -219,6 +219,17 @@ class Simulation:
             self._step_by_roles(layer, dt)
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
+
+    def _stop_silent_robots(self) -> None:
+        """The watchdog: zero the commands of the robots not commanded for ``watchdog_timeout``. Commands only
+        move ``last_command_us`` forward, so no robot can be silent before the oldest command seen at the last
+        look has timed out: until then a step skips the look (a robot driven at 10 Hz is never looked at)."""
+        timeout_us = round(self.watchdog_timeout * MICROSECONDS)
+        if self.sim_time_us - self._oldest_command_us < timeout_us:
+            return
+        silent = (self.sim_time_us - self.last_command_us) >= timeout_us
+        self.commands[silent] = 0.0
+        self._oldest_command_us = int(self.last_command_us.min())
 
     def _step_fused(self, layer: int, dt: float, cast: bool) -> None:
         """The moves, odometry and (when ``cast``) every ranger's scan of a step in few compiled calls, the same

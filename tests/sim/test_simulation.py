@@ -178,6 +178,31 @@ def test_watchdog_stops_a_robot_without_commands() -> None:
     assert sim.true_poses[0][0] == x
 
 
+def test_watchdog_stops_each_silent_robot_at_its_own_time_also_after_a_reset() -> None:
+    """The watchdog looks at the robots only once the oldest command can have timed out: a robot driven at
+    every step is never stopped, one left alone is stopped on time, a command written straight into
+    ``commands`` of a silent robot is dropped at the next step, and a reset starts the clocks again."""
+    sim = Simulation(world('bot( pose [2 2 0 0] ) bot( pose [5 5 0 0] )'), seed=0, watchdog_timeout=0.25)
+    sim.set_velocities(np.array([0, 1]), np.array([[0.5, 0.0, 0.0], [0.4, 0.0, 0.0]]))
+    moving = []
+    for _ in range(6):
+        sim.set_velocity(0, 0.5, 0.0, 0.0)
+        sim.step()
+        moving.append(sim.velocities[:, 0].tolist())
+    assert moving == [[0.5, 0.4], [0.5, 0.4], [0.5, 0.0], [0.5, 0.0], [0.5, 0.0], [0.5, 0.0]]
+    sim.commands[1, 0] = 0.3  # not a command: the watchdog still counts robot 1 silent
+    sim.set_velocity(0, 0.5, 0.0, 0.0)
+    sim.step()
+    assert sim.velocities[:, 0].tolist() == [0.5, 0.0]
+    sim.reset()
+    sim.set_velocities(np.array([0, 1]), np.array([[0.2, 0.0, 0.0], [0.1, 0.0, 0.0]]))
+    after = []
+    for _ in range(4):
+        sim.step()
+        after.append(sim.velocities[:, 0].tolist())
+    assert after == [[0.2, 0.1], [0.2, 0.1], [0.0, 0.0], [0.0, 0.0]]
+
+
 def test_set_velocities_commands_several_robots_as_set_velocity_does_each() -> None:
     robots = 'bot( pose [2 2 0 0] ) bot( pose [5 5 0 0] ) bot( pose [7 2 0 0] )'
     one_by_one, at_once = sim_of(robots), sim_of(robots)
