@@ -1,10 +1,10 @@
 """What steps published, copied off the simulation: what the stepping side sends the bag writer process.
 
 The stepping side copies each step into a :class:`StepBatch`, column by column (one preallocated array per
-value of a per-step topic, a row per step), and sends the batch whole: a step costs it a few array copies, and
-pickling a batch a few arrays however many steps it holds (a step's values pickled one by one cost about as
-much as simulating a one-robot step). The writer reads each topic's values for all the batch's steps at once
-(:meth:`StepBatch.values`).
+quantity the per-step topics read, :class:`~stage_sim.interface.topics.Quantity`, a row per step), and sends the
+batch whole: a step costs it a few array copies, and pickling a batch a few arrays however many steps it holds
+(a step's values pickled one by one cost about as much as simulating a one-robot step). The writer derives each
+topic's values for all the batch's steps at once (:meth:`StepBatch.values`).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 
 from stage_sim.interface import fields
 from stage_sim.interface.names import RobotNames
-from stage_sim.interface.topics import Topic
+from stage_sim.interface.topics import SIM_TIME_US, Quantity, StepValues, Topic
 
 if TYPE_CHECKING:
     from stage_sim.sim.simulation import Simulation
@@ -115,26 +115,6 @@ class _Array(_Column):
         return _Array(self.data[:count])
 
 
-class _Tuple(_Column):
-    """A tuple of array values (odometry: poses and velocities)."""
-
-    def __init__(self, parts: list[_Array]) -> None:
-        self.parts = parts
-
-    def empty(self, size: int) -> _Tuple:
-        return _Tuple([part.empty(size) for part in self.parts])
-
-    def put(self, k: int, value: tuple) -> None:
-        for part, item in zip(self.parts, value, strict=True):
-            part.data[k] = item  # _Array.put, inlined: this runs every step
-
-    def rows(self, count: int) -> tuple:
-        return tuple(part.rows(count) for part in self.parts)
-
-    def head(self, count: int) -> _Tuple:
-        return _Tuple([part.head(count) for part in self.parts])
-
-
 class _Scans(_Column):
     """The scans a step measured (:class:`fields.LatestScans`), packed: the measured rangers' beams end to end in
     one row, and which rangers measured."""
@@ -174,9 +154,7 @@ class _Scans(_Column):
 
 
 def _column(value: Any, sim: Simulation) -> _Column:
-    """The column for a topic's values, shaped after one step's ``value``."""
-    if isinstance(value, tuple):
-        return _Tuple([_Array.like(item) for item in value])
+    """The column for a quantity's values, shaped after one step's ``value``."""
     if isinstance(value, fields.LatestScans):
         counts = [len(robot.rangers) for robot in sim.robots]
         first = tuple(int(i) for i in np.concatenate([[0], np.cumsum(counts)]))
@@ -184,23 +162,44 @@ def _column(value: Any, sim: Simulation) -> _Column:
     return _Array.like(value)
 
 
-class StepBatch:
-    """Up to ``size`` consecutive steps' values, a column per value; :meth:`capture` adds one."""
+def _step_values(topic: Topic) -> StepValues:
+    """What ``topic``'s values are made of: it must be a per-step topic."""
+    if not isinstance(topic.values, StepValues):
+        raise TypeError(f"{topic.name} is not published every step")
+    return topic.values
 
-    def __init__(self, times: _Array, columns: list[_Column], size: int) -> None:
-        self._times = times.empty(size)
+
+class StepBatch:
+    """Up to ``size`` consecutive steps' quantities (:class:`~stage_sim.interface.topics.Quantity`), a column per
+    quantity the topics read: one the topics share (odom's and /tf's odometry poses, /clock's sim time, which
+    also times the steps) is copied once a step, and each topic's values are derived for all the steps at once
+    where they are read (:meth:`values`, in the writer process)."""
+
+    def __init__(self, quantities: tuple[Quantity, ...], columns: list[_Column],
+                 uses: list[tuple[Topic, tuple[int, ...]]], size: int) -> None:
+        self._quantities = quantities
         self._columns = [column.empty(size) for column in columns]
+        self._uses = uses
+        """Per topic, the columns of the quantities its values are derived from."""
         self.count = 0
+        pairs = list(zip((quantity.read for quantity in quantities), self._columns, strict=True))
+        self._arrays = [(read, column.data) for read, column in pairs if isinstance(column, _Array)]
+        """What :meth:`capture` copies by a row assignment (inlined: a method call per quantity costs as much)."""
+        self._packed = [(read, column) for read, column in pairs if not isinstance(column, _Array)]
 
     @classmethod
     def first(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic], size: int) -> StepBatch:
         """An empty batch for the values of the ``stepped`` topics, shaped after the simulation's."""
-        columns = [_column(topic.values(sim, names), sim) for topic in stepped]
-        return cls(_Array.like(sim.sim_time_us), columns, size)
+        quantities = [SIM_TIME_US]  # the steps' times, whatever the topics
+        for topic in stepped:
+            quantities += [q for q in _step_values(topic).reads if q not in quantities]
+        uses = [(topic, tuple(quantities.index(q) for q in _step_values(topic).reads)) for topic in stepped]
+        columns = [_column(quantity.read(sim), sim) for quantity in quantities]
+        return cls(tuple(quantities), columns, uses, size)
 
     def empty(self, size: int) -> StepBatch:
         """An empty batch like this one (the stepping side starts one as it hands the last over)."""
-        return StepBatch(self._times, self._columns, size)
+        return StepBatch(self._quantities, self._columns, self._uses, size)
 
     def clear(self) -> None:
         """Empty this batch to fill it again (its arrays are kept: the sender has sent their contents)."""
@@ -208,26 +207,30 @@ class StepBatch:
 
     @property
     def full(self) -> bool:
-        return self.count == len(self._times.data)
+        return self.count == len(self._columns[0].data)
 
     def capture(self, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> None:
-        """Copy the step just taken."""
+        """Copy the step just taken (``names`` and ``stepped``: those the batch was made for, which fixed the
+        quantities it copies)."""
         k = self.count
-        self._times.put(k, sim.sim_time_us)
-        for column, topic in zip(self._columns, stepped, strict=True):
-            column.put(k, topic.values(sim, names))
+        for read, data in self._arrays:
+            data[k] = read(sim)
+        for read, column in self._packed:
+            column.put(k, read(sim))
         self.count += 1
 
     @property
     def times(self) -> np.ndarray:
         """The sim time (µs) of each step held, in order."""
-        return self._times.rows(self.count)
+        return self._columns[0].rows(self.count)
 
     def values(self) -> list[Any]:
         """Each topic's values for all the steps held (a leading axis per step), in the topics' order."""
-        return [column.rows(self.count) for column in self._columns]
+        rows = [column.rows(self.count) for column in self._columns]
+        return [_step_values(topic).derive(*[rows[i] for i in columns]) for topic, columns in self._uses]
 
     def __getstate__(self) -> dict[str, Any]:
-        """Only the rows filled travel to the writer."""
-        return {"count": self.count, "_times": self._times.head(self.count),
+        """Only the rows filled travel to the writer, which reads them but copies no step (the quantities'
+        readers, functions, stay behind)."""
+        return {"count": self.count, "_quantities": (), "_arrays": [], "_packed": [], "_uses": self._uses,
                 "_columns": [column.head(self.count) for column in self._columns]}

@@ -2,11 +2,12 @@
 
 Each :class:`Topic` says its name rule (absolute for the world, relative under a robot's prefix, numbered per
 ranger), its message type, its QoS, when it is published and which values of a :class:`Simulation` its
-messages carry. The ROS node (:mod:`stage_sim.ros.stageros`) advertises and publishes them in a loop over
-this registry, the bag recorder (:mod:`stage_sim.bags`) records the same list; each side keeps one message
-filler per topic (:mod:`stage_sim.ros.topic_messages`, :mod:`stage_sim.bags.messages`). The bag side fills
-its rosbags messages only for the latched topics and for the one template per endpoint of the per-step ones,
-whose serialised bytes it then refills in place (:mod:`stage_sim.bags.layouts`).
+messages carry (a per-step topic's are derived from some of the step's :class:`Quantity`, which a recording
+copies once a step however many topics read them). The ROS node (:mod:`stage_sim.ros.stageros`) advertises and
+publishes them in a loop over this registry, the bag recorder (:mod:`stage_sim.bags`) records the same list;
+each side keeps one message filler per topic (:mod:`stage_sim.ros.topic_messages`, :mod:`stage_sim.bags.messages`).
+The bag side fills its rosbags messages only for the latched topics and for the one template per endpoint of the
+per-step ones, whose serialised bytes it then refills in place (:mod:`stage_sim.bags.layouts`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,10 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import Enum
+from operator import attrgetter
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from stage_sim.interface import fields, frames
 from stage_sim.interface.names import RobotNames
@@ -43,6 +47,50 @@ class Timing(Enum):
 
 Values = Callable[["Simulation", Sequence[RobotNames]], Any]
 """What one publication of a topic is made of (world topics: the value; robot topics: indexed by robot)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Quantity:
+    """One thing a step's topics are made of, read off the simulation. Several topics read the same one (odom and
+    /tf the odometry poses, /clock the sim time that stamps every message): a recording copies each once a step."""
+
+    name: str
+    read: Callable[[Simulation], Any]
+
+
+SIM_TIME_US = Quantity("sim_time_us", attrgetter("sim_time_us"))
+ODOMETRY_POSES = Quantity("odometry_poses", attrgetter("odometry_poses"))
+VELOCITIES = Quantity("velocities", attrgetter("velocities"))
+TRUE_POSES = Quantity("true_poses", attrgetter("true_poses"))
+STALLED = Quantity("stalled", attrgetter("stalled"))
+SCANS = Quantity("scans", fields.latest_scans)
+
+
+def _same(value: Any) -> Any:
+    """The values of a topic that reads one quantity: that quantity as it is."""
+    return value
+
+
+@dataclass(frozen=True)
+class StepValues:
+    """A per-step topic's values (a :data:`Values`) made of some of the step's quantities by ``derive``. ``derive``
+    takes one step's quantities as well as many steps' stacked (a leading axis per step): a recording copies
+    the quantities, not the values, and derives the values of a whole batch of steps in its writer process."""
+
+    reads: tuple[Quantity, ...]
+    derive: Callable[..., Any] = _same
+
+    def __call__(self, sim: Simulation, names: Sequence[RobotNames]) -> Any:
+        return self.derive(*[quantity.read(sim) for quantity in self.reads])
+
+
+def _ground_truth(poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The true poses and :attr:`Simulation.true_velocities` (the velocities, zero while stalled) of one step or a
+    stack of steps: a recording copies the velocities and stall flags, which other topics read too, and derives
+    these in its writer process."""
+    velocities = velocities.copy()
+    velocities[stalled] = 0.0
+    return poses, velocities
 
 
 @dataclass(frozen=True)
@@ -107,17 +155,15 @@ def endpoints(topic: Topic, names: Sequence[RobotNames]) -> list[Endpoint]:
             for robot, robot_names in enumerate(names) for k, name in enumerate(topic.names_on(robot_names))]
 
 
-CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", RELIABLE_10, Scope.WORLD,
-              values=lambda sim, names: sim.sim_time_us)
+CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", RELIABLE_10, Scope.WORLD, values=StepValues((SIM_TIME_US,)))
 ODOM = Topic("odom", "nav_msgs/msg/Odometry", RELIABLE_10, Scope.ROBOT,
-             values=lambda sim, names: (sim.odometry_poses, sim.velocities))
+             values=StepValues((ODOMETRY_POSES, VELOCITIES), lambda poses, velocities: (poses, velocities)))
 GROUND_TRUTH = Topic("base_pose_ground_truth", "nav_msgs/msg/Odometry", RELIABLE_10, Scope.ROBOT,
-                     values=lambda sim, names: (sim.true_poses, sim.true_velocities))
-STALL = Topic("stall", "std_msgs/msg/Bool", RELIABLE_10, Scope.ROBOT, values=lambda sim, names: sim.stalled)
+                     values=StepValues((TRUE_POSES, VELOCITIES, STALLED), _ground_truth))
+STALL = Topic("stall", "std_msgs/msg/Bool", RELIABLE_10, Scope.ROBOT, values=StepValues((STALLED,)))
 SCAN = Topic("base_scan", "sensor_msgs/msg/LaserScan", RELIABLE_10, Scope.RANGER, Timing.MEASURED,
-             values=lambda sim, names: fields.latest_scans(sim))
-TF = Topic("/tf", "tf2_msgs/msg/TFMessage", TF_STREAM, Scope.WORLD,
-           values=lambda sim, names: sim.odometry_poses)
+             values=StepValues((SCANS,)))
+TF = Topic("/tf", "tf2_msgs/msg/TFMessage", TF_STREAM, Scope.WORLD, values=StepValues((ODOMETRY_POSES,)))
 """One message per step with every robot's ``odom → base_footprint``."""
 TF_STATIC = Topic("/tf_static", "tf2_msgs/msg/TFMessage", LATCHED, Scope.WORLD, Timing.START,
                   values=lambda sim, names: frames.static_edges(sim.robots, list(names)))

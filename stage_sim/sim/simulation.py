@@ -304,7 +304,8 @@ class Simulation:
     def true_velocities(self) -> np.ndarray:
         """The body-frame twist of each robot's true motion: its velocity, zero while stalled (the command stands,
         the body does not move). A copy with the stalled rows zeroed: the same values as ``np.where``, in a third of
-        its time (read every step by stageros and by a recording)."""
+        its time. The ground-truth topic derives the same values from the velocities and stall flags (a recording
+        derives them in its writer process, not per step)."""
         velocities = self.velocities.copy()
         velocities[self.stalled] = 0.0
         return velocities

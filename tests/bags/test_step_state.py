@@ -65,3 +65,36 @@ def test_a_pickled_batch_gives_back_every_step(tmp_path) -> None:
                 np.testing.assert_array_equal(packed[0], scan[0])
                 np.testing.assert_array_equal(packed[1], scan[1])
     assert skipped > 0  # the slow rangers skipped steps
+
+
+AGAINST_A_WALL = """resolution 0.02
+model( size [1 4 1] pose [1 0 0 0] )
+position( size [0.4 0.4 0.2] pose [0 0 0 0] )
+position( size [0.4 0.4 0.2] pose [-3 0 0 0] )
+"""
+
+
+def test_topics_reading_the_same_quantity_share_one_copy_and_derived_values_are_the_simulation_s() -> None:
+    """odom and /tf share the odometry poses; ground truth's velocities, zero while stalled, are derived from the
+    copied velocities and stall flags after the batch's trip (robots without rangers, no scan topic)."""
+    sim = Simulation(load_world_text(AGAINST_A_WALL, "wall.world"), seed=0)
+    names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers)) for r in sim.robots]
+    stepped = [topics.ODOM, topics.GROUND_TRUTH, topics.TF]
+    batch = StepBatch.first(sim, names, stepped, 12)
+    expected = []
+    for _ in range(12):
+        sim.set_velocity(0, 1.0, 0.0, 0.0)  # into the wall: it stalls
+        sim.set_velocity(1, -0.5, 0.0, 0.2)
+        sim.step()
+        batch.capture(sim, names, stepped)
+        expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_poses.copy(), sim.true_velocities))
+    received = pickle.loads(pickle.dumps(batch))
+    odometry, truth, tf = received.values()
+    assert np.shares_memory(odometry[0], tf)
+    np.testing.assert_array_equal(received.times, [time_us for time_us, *_ in expected])
+    np.testing.assert_array_equal(tf, [poses for _, poses, *_ in expected])
+    np.testing.assert_array_equal(truth[0], [poses for *_, poses, _ in expected])
+    true_velocities = np.array([velocities for *_, velocities in expected])
+    assert true_velocities.tobytes() == truth[1].tobytes()
+    assert (true_velocities[:, 0] == 0.0).all(axis=1).any()  # the first robot stalled
+    assert (true_velocities[:, 1, 0] == -0.5).all()  # the second did not
