@@ -158,7 +158,7 @@ class BagRecorder:
         now = time.monotonic()
         if not self._pending.count:
             self._pending_since = now
-        self._pending.capture(self._sim, self._names, self._messages.stepped)
+        self._pending.capture(self._sim)
         if self._pending.full or now - self._pending_since >= WAKE_S:
             self._hand_over(wait=self.lossless)
 

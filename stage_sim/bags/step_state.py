@@ -209,9 +209,8 @@ class StepBatch:
     def full(self) -> bool:
         return self.count == len(self._columns[0].data)
 
-    def capture(self, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic]) -> None:
-        """Copy the step just taken (``names`` and ``stepped``: those the batch was made for, which fixed the
-        quantities it copies)."""
+    def capture(self, sim: Simulation) -> None:
+        """Copy the step just taken: the quantities of the topics the batch was made for."""
         k = self.count
         for read, data in self._arrays:
             data[k] = read(sim)

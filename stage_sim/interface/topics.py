@@ -23,6 +23,7 @@ import numpy as np
 from stage_sim.interface import fields, frames
 from stage_sim.interface.names import RobotNames
 from stage_sim.interface.qos import LATCHED, RELIABLE_10, TF_STREAM, Qos
+from stage_sim.sim.kinematics import true_velocities
 
 if TYPE_CHECKING:
     from stage_sim.sim.simulation import Simulation
@@ -85,12 +86,9 @@ class StepValues:
 
 
 def _ground_truth(poses: np.ndarray, velocities: np.ndarray, stalled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The true poses and :attr:`Simulation.true_velocities` (the velocities, zero while stalled) of one step or a
-    stack of steps: a recording copies the velocities and stall flags, which other topics read too, and derives
-    these in its writer process."""
-    velocities = velocities.copy()
-    velocities[stalled] = 0.0
-    return poses, velocities
+    """The true poses and twists of one step or a stack of steps: a recording copies the velocities and stall
+    flags, which other topics read too, and derives these in its writer process."""
+    return poses, true_velocities(velocities, stalled)
 
 
 @dataclass(frozen=True)

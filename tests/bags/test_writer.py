@@ -39,7 +39,7 @@ def test_a_batch_cut_short_ends_the_input_and_the_bag_is_still_finished(tmp_path
     batch = StepBatch.first(sim, names, builder.stepping.stepped, 5)
     for _ in range(5):
         sim.step()
-        batch.capture(sim, names, builder.stepping.stepped)
+        batch.capture(sim)
     send_batch(steps, batch)
     if cut == "in its arrays":
         steps.send(BatchFrame(b"the next batch, without its arrays", 3))
