@@ -135,9 +135,9 @@ class FusedResult:
 
 
 class FusedStep:
-    """A whole step of a world on the compiled kernels in two calls (:mod:`stage_sim.sim.fused_kernels`): the
-    end poses and odometry, then the contacts and every ray; the numpy calls left are one pair of cos and sin,
-    the noise's draws and the new arrays. For worlds whose robots share one height band and whose rays one
+    """A whole step of a world on the compiled kernels in one call (:mod:`stage_sim.sim.fused_kernels`): the
+    end poses and odometry, the contacts and every ray; the numpy calls left are the noise's draws and the new
+    arrays. For worlds whose robots share one height band and whose rays one
     height, on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by
     role."""
 
@@ -166,14 +166,12 @@ class FusedStep:
             "cell": np.empty(beams, dtype=np.int64), "hit_robot": np.empty(beams, dtype=np.int32),
             "headings": np.zeros((2 * n, 3)),  # column 2: a step's new headings (end poses, then odometry) ...
             "known": np.full((4, n), np.nan),  # ... the headings of the poses, odometry, layers 0 and 1 ...
-            "known_trig": np.empty((4, 2, n)),  # ... and their numpy cos and sin
+            "known_trig": np.empty((4, 2, n)),  # ... and their cos and sin
             **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
                        world, strict=True)),
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
         }
         self._beams = beams
-        self._remembered = self._fields["known"], self._fields["known_trig"], self._fields["headings"]
-        self._new_headings = self._fields["headings"][:, 2]  # a strided column, as the roles' numpy cos and sin read
         # scratch: the end poses, the cos and sin of the new headings and those of the new poses
         self._scratch = (np.empty((n, 3)), np.empty((2, 2 * n)), np.empty((2, n)))
         self._pack()
@@ -206,21 +204,14 @@ class FusedStep:
         robots = self._robots
         if robots.ids is not self._ids:
             self._pack()
-        n, world, integrated, end_trig, final_trig = poses.shape[0], self._world, *self._scratch
-        odometry = np.empty((n, 3))
-        known, known_trig, headings = self._remembered
-        if not fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
-                                     known_trig, True, integrated, odometry, headings):
-            self._learn(poses, layers, layer, estimates)
-            fused_kernels.advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known,
-                                  known_trig, False, integrated, odometry, headings)
-        np.cos(self._new_headings, out=end_trig[0])
-        np.sin(self._new_headings, out=end_trig[1])
-        final, stalled_out, layers = np.empty((n, 3)), np.empty(n, dtype=bool), layers.copy()
+        n, (integrated, end_trig, final_trig) = poses.shape[0], self._scratch
+        odometry, final, stalled_out = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=bool)
+        layers = layers.copy()
         published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
-        cells, cell_robot, marked, tiles, active = fused_kernels.step(
-            world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
-            stalled_out, final_trig, cast, robots.marked, robots.active, published, intensity)
+        cells, cell_robot, marked, tiles, active = fused_kernels.whole_step(
+            self._world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast,
+            robots.marked, robots.active, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
+            intensity)
         if not cast:
             return FusedResult(final, stalled_out, odometry, layers, None)
         robots.took(marked, active)
@@ -244,19 +235,3 @@ class FusedStep:
                                                 np.empty(self._beams, dtype=np.float32),
                                                 np.empty(self._beams, dtype=np.float32))
         robots.took(marked, active)
-
-    def _learn(self, poses: np.ndarray, layers: np.ndarray, layer: int, estimates: np.ndarray) -> None:
-        """Compute the cos and sin of the start headings anew (the first step, or poses set between steps)."""
-        known, known_trig = self._fields["known"], self._fields["known_trig"]
-        for row, source in ((0, poses), (1, estimates), (2 + layer, layers[layer])):
-            known[row] = source[:, 2]
-            known_trig[row] = _trig(source)
-
-
-def _trig(poses: np.ndarray) -> np.ndarray:
-    """(2, N): numpy's cos and sin of the headings ``poses[:, 2]``, the calls the role-by-role kernels make."""
-    heading = poses[:, 2]
-    trig = np.empty((2, heading.size))
-    np.cos(heading, out=trig[0])
-    np.sin(heading, out=trig[1])
-    return trig

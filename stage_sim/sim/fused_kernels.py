@@ -1,13 +1,14 @@
-"""Compiled (numba) step in two calls: the end poses and odometry, then the contacts and every laser's cast.
+"""Compiled (numba) step in one call: the end poses and odometry, the contacts and every laser's cast.
 
 Why: for one robot a step of the compiled backend made some sixty calls (kernels, numpy, Python), which
 cost twice the ray walk itself. Here each part of a step is one call of the existing kernels
 (:mod:`stage_sim.sim.body_kernels`, :mod:`stage_sim.sim.motion_kernels`, :mod:`stage_sim.sensing.robot_kernels`,
 :mod:`stage_sim.sensing.traversal`, :mod:`stage_sim.sim.ranger_kernels`) in the order and with the arguments
 the role-by-role step gives them, so every pose, flag, range and intensity is the same bit for bit
-(``tests/sim/test_step_digests.py``, ``tests/sim/test_kernel_identity.py``). The trigonometry stays in numpy:
-the caller passes the cosines and sines of every heading the kernels place a point with, computed once per
-heading: a step's new headings are the next one's start (remembered, and checked bit for bit before use).
+(``tests/sim/test_step_digests.py``, ``tests/sim/test_kernel_identity.py``). The role-by-role kernels take the
+cosines and sines of the headings from numpy; here they are computed in the kernel (libm's, as numpy's float64
+``cos`` and ``sin`` are: ``tests/sim/test_trigonometry.py`` holds them equal bit for bit), once per heading: a
+step's new headings are the next one's start (remembered, and checked bit for bit before use).
 
 What never changes between two steps of a world (bodies, static layers, beam tables, scratch arrays) travels
 in one :class:`FusedWorld`: numba checks the type of every argument of every call, some 0.1 µs an array, and
@@ -119,7 +120,7 @@ def advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, 
     into ``odometry``, with the cos and sin of their start headings remembered from the last step; their new
     headings into ``headings[:, 2]`` (end poses, then odometry), whose cos and sin the step needs next.
 
-    ``known`` (4, N): the headings whose numpy cos and sin ``known_trig`` (4, 2, N) holds, of the poses, the
+    ``known`` (4, N): the headings whose cos and sin ``known_trig`` (4, 2, N) holds, of the poses, the
     odometry and layers 0 and 1 (a :class:`FusedWorld`'s, given apart: fewer arguments to check than the world).
     With ``check``, returns False (and does nothing) unless they are the headings of ``poses``, ``estimates``
     and ``layers[layer]`` bit for bit (a reset or a pose set between steps)."""
@@ -136,6 +137,35 @@ def advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, 
         headings[i, 2] = integrated[i, 2]
         headings[n + i, 2] = odometry[i, 2]
     return True
+
+
+@numba.njit(**_JIT)
+def _remember(known, known_trig, row, poses):
+    """Row ``row`` of ``known`` and ``known_trig``: the headings of ``poses`` and their cos and sin."""
+    for i in range(poses.shape[0]):
+        known[row, i] = poses[i, 2]
+        known_trig[row, 0, i], known_trig[row, 1, i] = math.cos(poses[i, 2]), math.sin(poses[i, 2])
+
+
+@numba.njit(**_JIT)
+def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast, old_marked,
+               active, integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity):
+    """A whole step: :func:`advance` from the start headings' remembered cos and sin (worked out anew when they
+    are not those of ``poses``, ``estimates`` and ``layers[layer]``: the first step, a reset, a pose set between
+    steps), the cos and sin of the new headings into ``end_trig`` (2, 2N), then :func:`step`, whose answer it
+    returns. ``integrated``, ``end_trig`` and ``final_trig`` are the caller's scratch."""
+    known, known_trig, headings = world.known, world.known_trig, world.headings
+    if not advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known, known_trig, True,
+                   integrated, odometry, headings):
+        _remember(known, known_trig, 0, poses)
+        _remember(known, known_trig, 1, estimates)
+        _remember(known, known_trig, 2 + layer, layers[layer])
+        advance(poses, layers, layer, estimates, velocities, errors, dt, uses_odom, known, known_trig, False,
+                integrated, odometry, headings)
+    for k in range(headings.shape[0]):
+        end_trig[0, k], end_trig[1, k] = math.cos(headings[k, 2]), math.sin(headings[k, 2])
+    return step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
+                stalled_out, final_trig, cast, old_marked, active, published, intensity)
 
 
 @numba.njit(**_JIT)
