@@ -24,6 +24,7 @@ layer). The filled footprints are made only when a map is asked for.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from itertools import groupby
@@ -195,14 +196,21 @@ def build_static_raster(
     return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
 
 
-def with_models(raster: StaticRaster, models: list[Model]) -> StaticRaster | None:
+def polygon_edges(vertices: np.ndarray) -> np.ndarray:
+    """The cells Stage marks for one closed polygon of vertex cells (:func:`edge_cells` of it alone)."""
+    return edge_cells([vertices])
+
+
+def with_models(raster: StaticRaster, models: list[Model],
+                trace: Callable[[np.ndarray], np.ndarray] = polygon_edges) -> StaticRaster | None:
     """The raster of a world that is ``raster``'s with the top-level ``models`` appended (an episode's
-    obstacles): the bodies already rasterised are shared, only the new ones are traced. It is the one
-    :func:`build_static_raster` makes of that world while every new cell lies on the grid; None when one
-    does not (the grid would grow, and everything be placed anew)."""
+    obstacles): the bodies already rasterised are shared, only the new ones are traced, each polygon by
+    ``trace`` (:func:`polygon_edges`, or its compiled twin). It is the one :func:`build_static_raster` makes of
+    that world while every new cell lies on the grid; None when one does not (the grid would grow, and
+    everything be placed anew)."""
     shapes = _world_shapes(models)
     vertices = [vertex_cells(part.points, raster.resolution) for part in shapes]
-    outlines = [edge_cells([v]) for v in vertices]
+    outlines = [trace(v) for v in vertices]
     low = np.array([round(raster.origin_xy[0] / raster.resolution), round(raster.origin_xy[1] / raster.resolution)])
     high = low + np.array(raster.shape[::-1]) - 1
     stacked = np.concatenate([np.zeros((0, 2), dtype=np.int64), *vertices, *outlines])

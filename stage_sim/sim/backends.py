@@ -10,14 +10,16 @@ Roles, each with the numpy reference and its compiled twin (identical answers bi
   :class:`~stage_sim.sim.compiled.CompiledCollisionChecker`);
 * motion: :class:`Motion` (:class:`ReferenceMotion`, :class:`~stage_sim.sim.compiled.CompiledMotion`);
 * laser returns: :class:`HitIntensity` (:func:`~stage_sim.sim.returns.hit_intensity`,
-  :func:`stage_sim.sim.compiled.hit_intensity`).
+  :func:`stage_sim.sim.compiled.hit_intensity`);
+* tracing a static polygon's outline (an episode's new obstacles): :data:`Trace`
+  (:func:`~stage_sim.maps.raster.polygon_edges`, :func:`stage_sim.sim.body_kernels.polygon_outline`).
 
 The numba backend's module is imported on first request only: the numpy path runs without numba.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache, partial
 from typing import TYPE_CHECKING, Protocol
@@ -25,6 +27,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from stage_sim.backend import KERNELS
+from stage_sim.maps.raster import polygon_edges
 from stage_sim.maps.tiles import CellValues, TileLayer
 from stage_sim.sensing.casters import RayCaster, make_caster
 from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame, place
@@ -50,6 +53,10 @@ class ContactFactory(Protocol):
 
     def __call__(self, bodies: Bodies, grid: GridFrame, layers: list[TileLayer], layer_of_robot: np.ndarray,
                  collides: np.ndarray) -> Contact: ...
+
+
+Trace = Callable[[np.ndarray], np.ndarray]
+"""The cells Stage marks for one closed polygon of vertex cells (M, 2), in its walk's order (K, 2)."""
 
 
 class Motion(Protocol):
@@ -139,18 +146,20 @@ class Backend:
     motion: Motion
     hit_intensity: HitIntensity
     fused: FusedFactory
+    trace: Trace
 
 
 def _numpy() -> Backend:
     return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity,
-                   no_fused_step)
+                   no_fused_step, polygon_edges)
 
 
 def _numba() -> Backend:
-    from stage_sim.sim import compiled  # imports numba
+    from stage_sim.sim import body_kernels, compiled  # imports numba
 
     return Backend("numba", partial(make_caster, kernels="numba"), compiled.CompiledCollisionChecker,
-                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of)
+                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of,
+                   body_kernels.polygon_outline)
 
 
 #: Every backend by name, built on first request.

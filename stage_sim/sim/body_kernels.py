@@ -21,6 +21,19 @@ _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 walk = numba.njit(**_JIT)(edge_walk)
 
 
+@numba.njit(**_JIT)
+def polygon_outline(vertices):
+    """:func:`~stage_sim.maps.polygon_raster.edge_cells` of one closed polygon of vertex cells (M, 2): the cells of
+    its walk, in the same order (an episode's new obstacles are traced with it)."""
+    m, count = vertices.shape[0], 0
+    for i in range(m):
+        j = i + 1 if i + 1 < m else 0
+        count += abs(vertices[j, 0] - vertices[i, 0]) + abs(vertices[j, 1] - vertices[i, 1])
+    cells = np.empty((count, 2), dtype=np.int64)
+    walk(vertices, cells, 0)
+    return cells
+
+
 @numba.njit(inline="always", **_JIT)
 def _floored_vertices(vertices, a, b, x, y, cos, sin, ppm, out):
     """``out[:b - a]``: the world cells of vertices ``a`` to ``b`` placed at (x, y) facing (cos, sin)."""

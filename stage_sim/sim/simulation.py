@@ -87,7 +87,7 @@ class Simulation:
         after this world's and they fit on its grid (an environment's reset builds one world per episode);
         else built from scratch."""
         added = self._added_static(description)
-        static = None if added is None else with_models(self.static, added)
+        static = None if added is None else with_models(self.static, added, backend_for(self.kernels).trace)
         if static is None:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below

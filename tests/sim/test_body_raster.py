@@ -22,6 +22,18 @@ def test_edge_walk_marks_the_cells_of_the_static_raster() -> None:
         np.testing.assert_array_equal(out, edge_cells([vertices]))
 
 
+def test_compiled_polygon_outline_is_the_static_rasters_edges() -> None:
+    """What an episode's new obstacles are traced with on the compiled kernels (``Backend.trace``)."""
+    from stage_sim.sim.body_kernels import polygon_outline
+
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        vertices = rng.integers(-60, 60, size=(rng.integers(1, 8), 2))
+        np.testing.assert_array_equal(polygon_outline(vertices), edge_cells([vertices]))
+    within_one_cell = np.array([[3, 4], [3, 4], [3, 4]])
+    assert polygon_outline(within_one_cell).shape == (0, 2) == edge_cells([within_one_cell]).shape
+
+
 def test_a_box_body_is_its_edges_floored_and_walked_at_the_pose() -> None:
     sim = Simulation.from_world(ROBOTS / "crowd_100.world", seed=0, kernels="numpy")
     cells, owner = sim.build_parts("numpy")[0].raster(sim.start_poses)

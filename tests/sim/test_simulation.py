@@ -322,16 +322,18 @@ def test_resets_cast_no_rays_and_the_next_step_scans_from_the_start_pose() -> No
     assert sim.scans[0][0].ranges[90] == pytest.approx(7.88)
 
 
-def test_a_world_with_static_models_added_simulates_as_if_built_from_scratch() -> None:
-    # An episode's obstacles: the simulation reuses its robots and raster and traces only the new bodies.
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
+def test_a_world_with_static_models_added_simulates_as_if_built_from_scratch(kernels: str) -> None:
+    # An episode's obstacles: the simulation reuses its robots and raster and traces only the new bodies (with
+    # the backend's tracer: the compiled one on numba).
     robots = 'bot( pose [2 5 0 0] ) bot( pose [6 6 0 90] )'
     base = world(robots)
     boxes = load_world_text(ROOM.format(drive="diff", extra="") + robots
                             + 'model( name "box" size [0.5 0.3 1] pose [4 5.2 0 30] )'
                             + 'model( name "low" size [0.4 0.4 0.05] pose [7 4 0 0] )', "test.world")
     extended = WorldDescription(base.path, base.settings, [*base.models, *boxes.models[-2:]])
-    original = Simulation(base, seed=1)
-    built, fresh = original.with_static_models(extended, seed=4), Simulation(extended, seed=4)
+    original = Simulation(base, seed=1, kernels=kernels)
+    built, fresh = original.with_static_models(extended, seed=4), Simulation(extended, seed=4, kernels=kernels)
     assert built.robots is original.robots and built.static.bodies[0] is original.static.bodies[0]  # reused
     assert built.static.shape == fresh.static.shape and built.static.origin_xy == fresh.static.origin_xy
     assert [b.name for b in built.static.bodies] == [b.name for b in fresh.static.bodies]
