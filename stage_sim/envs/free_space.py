@@ -118,8 +118,14 @@ class FreeSpace:
             return self._blocked_of(sim)
         bands = {sim.robots[i].z_band for i in self._robots}
         blocked = self._blocked.copy()
+        if sim.kernels == "numba":
+            from stage_sim.envs.free_space_kernels import mark_filled
         for body in bodies[len(self._bodies):]:
-            if any(body.blocks(*band) for band in bands):
+            if not any(body.blocks(*band) for band in bands):
+                continue
+            if sim.kernels == "numba":
+                mark_filled(blocked, body)
+            else:
                 blocked.ravel()[body.cells] = True
         return blocked
 

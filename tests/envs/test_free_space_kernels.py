@@ -55,3 +55,36 @@ def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float
         expected = valid & (ndimage.distance_transform_edt(~added) * resolution > reach)
         clear_near(valid, added, np.flatnonzero(added), offsets)
         np.testing.assert_array_equal(valid, expected)
+
+
+@pytest.mark.parametrize("resolution", [0.05, 0.037])
+def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> None:
+    """An episode's new bodies are marked blocked by the compiled fill (``mark_filled``): the very cells of
+    ``StaticBody.cells`` (outline and centres inside, even-odd), for boxes, concave and self-crossing polygons,
+    bodies of several polygons, and bodies partly off the grid."""
+    from stage_sim.envs.free_space_kernels import mark_filled
+    from stage_sim.maps.raster import StaticBody
+
+    rng = np.random.default_rng(int(resolution * 1000))
+    shape, origin = (90, 120), (-1.013, -0.71)
+    extent = np.array([shape[1], shape[0]]) * resolution
+    for _ in range(150):
+        polygons = []
+        for _ in range(int(rng.integers(1, 3))):
+            centre = np.array(origin) + rng.uniform(-0.2, 1.2, 2) * extent
+            if rng.random() < 0.5:  # a rotated box, as the obstacles scenario draws
+                (sx, sy), yaw = rng.uniform(0.05, 1.5, 2), rng.uniform(-np.pi, np.pi)
+                corners = np.array([[-sx, -sy], [sx, -sy], [sx, sy], [-sx, sy]]) / 2
+                rotation = np.array([[np.cos(yaw), -np.sin(yaw)], [np.sin(yaw), np.cos(yaw)]])
+                polygons.append(centre + corners @ rotation.T)
+            else:  # any polygon: concave, self-crossing, with horizontal edges on cell centres
+                points = centre + rng.uniform(-1.0, 1.0, (int(rng.integers(3, 9)), 2))
+                points[0, 1] = points[1, 1] = origin[1] + (int(rng.integers(0, shape[0])) + 0.5) * resolution
+                polygons.append(points)
+        outline = np.unique(rng.integers(0, shape[0] * shape[1], 20))
+        body = StaticBody("b", outline, (0.0, 1.0), 1.0, True, polygons, (resolution, origin, shape))
+        expected = np.zeros(shape, dtype=bool)
+        expected.ravel()[body.cells] = True
+        marked = np.zeros(shape, dtype=bool)
+        mark_filled(marked, body)
+        np.testing.assert_array_equal(marked, expected)
