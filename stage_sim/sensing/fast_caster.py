@@ -116,10 +116,7 @@ def bit_masks(layer: TileLayer) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
     if "bit_masks" not in layer.derived:
         bits = np.ascontiguousarray(layer.bits)
         rows = bits.view("<u4").reshape(bits.shape[0], bits.shape[1]).astype(np.uint32)
-        weights = np.uint32(1) << np.arange(rows.shape[1], dtype=np.uint32)
-        cols = np.empty_like(rows)
-        for x in range(rows.shape[1]):  # column x: bit y is bit x of row y
-            cols[:, x] = ((rows >> np.uint32(x)) & np.uint32(1)) @ weights
-        layer.derived["bit_masks"] = (rows, cols, (rows != 0).astype(np.uint32) @ weights,
-                                      (cols != 0).astype(np.uint32) @ weights)
+        cols, rows_used, cols_used = np.empty_like(rows), np.empty(len(rows), np.uint32), np.empty(len(rows), np.uint32)
+        traversal.tile_masks(rows, cols, rows_used, cols_used)
+        layer.derived["bit_masks"] = (rows, cols, rows_used, cols_used)
     return layer.derived["bit_masks"]

@@ -54,6 +54,27 @@ _CHUNK = 64
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
+@numba.njit(**_JIT)
+def tile_masks(rows, cols, rows_used, cols_used):
+    """From each tile's row masks ``rows`` (T, 32) (bit x of row y: cell (y, x)): its column masks into ``cols``
+    (bit y of column x) and which rows and which columns hold a cell into ``rows_used`` and ``cols_used`` (T,)
+    (bit y, bit x): the tables the walk reads, built once per static layer."""
+    for t in range(rows.shape[0]):
+        used_rows = np.uint32(0)
+        for y in range(32):
+            if rows[t, y] != 0:
+                used_rows |= np.uint32(1) << np.uint32(y)
+        used_cols = np.uint32(0)
+        for x in range(32):
+            column = np.uint32(0)
+            for y in range(32):
+                column |= ((rows[t, y] >> np.uint32(x)) & np.uint32(1)) << np.uint32(y)
+            cols[t, x] = column
+            if column != 0:
+                used_cols |= np.uint32(1) << np.uint32(x)
+        rows_used[t], cols_used[t] = used_rows, used_cols
+
+
 @numba.njit(inline="always", **_JIT)
 def _distance(ax, ay, globx, globy, startx, starty, cosa, sina, ppm):
     """Stage's reported range: the distance travelled along the major axis, in metres."""
