@@ -12,6 +12,12 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   For the parallel env, ``robot_steps_per_s`` counts every robot of every step (every laser is cast every
   step, also those of agents that are done and stay as obstacles) and ``agent_steps_per_s`` only the live
   agents.
+* ``breakdown``: where the time of a one-robot ``NavigateEnv`` step goes on ``benchmarks/rl_peers.py``'s
+  scenario (the obstacles scenario: 8 boxes of 0.3–1 m drawn anew each episode, a uniformly random action per
+  step, episodes reset as they end): ``kernel_us`` inside the compiled step (moves, contacts and the ray walk),
+  ``step_glue_us`` the rest of ``Simulation.step`` (Python and numpy around it), ``env_us`` the env's own
+  work per step (actions, goal, observation, reward, info), ``reset_us`` the resets' time per step
+  (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement).
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -93,6 +99,56 @@ def parallel_speed(robots: int, seconds: float) -> dict:
             "core_share": round(core[0] / elapsed, 3)}
 
 
+def breakdown(seconds: float) -> dict:
+    """A one-robot env step's time by part (see the module's docstring), on the compiled kernels."""
+    from stage_sim.sim import fused_kernels
+    from stage_sim.sim.simulation import Simulation
+
+    env = NavigateEnv(scenario="obstacles", n_obstacles=8, obstacle_size=(0.3, 1.0), **ARENA)
+    env.reset(seed=0)
+    env.task.sim.wait_for_kernels()
+    rng = np.random.default_rng(1)
+    actions = np.stack([rng.uniform(0.0, 1.0, 1000), rng.uniform(-np.pi / 2, np.pi / 2, 1000)], -1).astype(np.float32)
+    spent = {"kernel": 0.0, "step": 0.0, "reset": 0.0}
+    whole_step, step = fused_kernels.whole_step, Simulation.step
+
+    def timed_kernel(*args: object) -> object:
+        start = time.perf_counter()
+        try:
+            return whole_step(*args)
+        finally:
+            spent["kernel"] += time.perf_counter() - start
+
+    def timed_step(sim: Simulation) -> None:
+        start = time.perf_counter()
+        step(sim)
+        spent["step"] += time.perf_counter() - start
+
+    fused_kernels.whole_step, Simulation.step = timed_kernel, timed_step
+    try:
+        steps = resets = 0
+        start = time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            _, _, terminated, truncated, _ = env.step(actions[steps % len(actions)])
+            steps += 1
+            if terminated or truncated:
+                inside = spent["kernel"], spent["step"]
+                began = time.perf_counter()
+                env.reset()
+                spent["reset"] += time.perf_counter() - began
+                spent["kernel"], spent["step"] = inside  # a reset's own still step counts in the reset
+                resets += 1
+        elapsed = time.perf_counter() - start
+    finally:
+        fused_kernels.whole_step, Simulation.step = whole_step, step
+    per_step = {key: value / steps * 1e6 for key, value in spent.items()}
+    return {"bench": "breakdown", "env": "NavigateEnv", "scenario": "obstacles_8", "steps": steps, "resets": resets,
+            "env_steps_per_s": round(steps / elapsed, 1), "us_per_step": round(elapsed / steps * 1e6, 1),
+            "kernel_us": round(per_step["kernel"], 1), "step_glue_us": round(per_step["step"] - per_step["kernel"], 1),
+            "env_us": round(elapsed / steps * 1e6 - per_step["step"] - per_step["reset"], 1),
+            "reset_us": round(per_step["reset"], 1), "ms_per_reset": round(spent["reset"] / max(resets, 1) * 1e3, 2)}
+
+
 def time_core(sim: Simulation, spent: list[float] | None = None) -> list[float]:
     """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list (``spent``,
     when several simulations share one)."""
@@ -128,6 +184,7 @@ def main() -> None:
     parser.add_argument("--worlds", type=int, nargs="*", default=[64], help="worlds of the vector env runs")
     args = parser.parse_args()
     print(json.dumps(single_speed(args.seconds)), flush=True)
+    print(json.dumps(breakdown(args.seconds)), flush=True)
     for worlds in args.worlds:
         print(json.dumps(vector_speed(worlds, args.seconds)), flush=True)
     for robots in (10, 100):
