@@ -33,12 +33,12 @@ from stage_sim.bags.errors import BagError
 from stage_sim.bags.messages import MessageBuilder
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import select, stageros_topics
-from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan, send_batch
+from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan, send_batch, send_finish
 from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
 BATCH_BYTES = 1024 * 1024
-"""Bytes of steps sent to the writer at once (at most 64 steps): one pickling and one wake-up of the writer per
+"""Bytes of steps sent to the writer at once (at most 64 steps): one message and one wake-up of the writer per
 batch instead of per step."""
 BATCH_STEPS = 64
 WAKE_S = 0.1
@@ -99,7 +99,11 @@ class BagRecorder:
         self.topics = select(stageros_topics(names, with_map, namespace), topics, namespace)
         builder = MessageBuilder(sim, names, self.topics)
         self._messages = builder.stepping
-        plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping)
+        step_bytes = 8 * sum(r.sensor.samples for robot in sim.robots for r in robot.rangers) + 200 * len(sim.robots)
+        batch_steps = max(1, min(BATCH_STEPS, BATCH_BYTES // step_bytes))
+        self._pending = StepBatch.first(sim, names, self._messages.stepped, batch_steps)
+        plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping,
+                          self._pending.layout)
         try:
             self._process, self._steps, self._reports = _start_writer()
         except OSError as exc:  # no processes left, or the interpreter is gone
@@ -125,11 +129,8 @@ class BagRecorder:
         """Whether the writer process went away (the sender could not pipe to it)."""
         self._closed: Closed | None = None
         """The writer's last report, once it has ended (early only after a bug)."""
-        step_bytes = 8 * sum(r.sensor.samples for robot in sim.robots for r in robot.rangers) + 200 * len(sim.robots)
-        self._batch_steps = max(1, min(BATCH_STEPS, BATCH_BYTES // step_bytes))
         self._queue: queue.Queue[StepBatch | None] = queue.Queue(
-            maxsize=max(2, QUEUE_BYTES // (self._batch_steps * step_bytes)))
-        self._pending = StepBatch.first(sim, names, self._messages.stepped, self._batch_steps)
+            maxsize=max(2, QUEUE_BYTES // (batch_steps * step_bytes)))
         self._spare: queue.SimpleQueue[StepBatch] = queue.SimpleQueue()
         """Batches the sender has sent, to be filled again: their memory is already mapped (a fresh 1 MiB batch
         costs the stepping thread a page fault every 4 kB it fills)."""
@@ -180,7 +181,7 @@ class BagRecorder:
         try:
             batch = self._spare.get_nowait()
         except queue.Empty:
-            return self._pending.empty(self._batch_steps)
+            return self._pending.empty()
         batch.clear()
         return batch
 
@@ -203,8 +204,8 @@ class BagRecorder:
         self._thread.join()
         if not self._writer_lost:
             try:
-                self._steps.send(Finish({"dropped_steps": str(self.dropped_steps),
-                                         "dropped_messages": str(self.dropped_messages)}))
+                send_finish(self._steps, Finish({"dropped_steps": str(self.dropped_steps),
+                                                 "dropped_messages": str(self.dropped_messages)}))
             except OSError:
                 self._writer_lost = True
         self._steps.close()
@@ -223,9 +224,8 @@ class BagRecorder:
         return self.summary
 
     def _send(self) -> None:
-        """The sender thread: pipe each queued batch to the writer (pickling it here, off the stepping thread,
-        its arrays out of band), until the closing None; if the writer has gone, the batches are dropped (close
-        says why)."""
+        """The sender thread: pipe each queued batch to the writer (its buffer, off the stepping thread), until
+        the closing None; if the writer has gone, the batches are dropped (close says why)."""
         while (batch := self._queue.get()) is not None:
             if not self._writer_lost:
                 try:

@@ -2,13 +2,16 @@
 
 The stepping side copies each step into a :class:`StepBatch`, column by column (one preallocated array per
 quantity the per-step topics read, :class:`~stage_sim.interface.topics.Quantity`, a row per step), and sends the
-batch whole: a step costs it a few array copies, and pickling a batch a few arrays however many steps it holds
-(a step's values pickled one by one cost about as much as simulating a one-robot step). The writer derives each
-topic's values for all the batch's steps at once (:meth:`StepBatch.values`).
+batch whole: a step costs it a few array copies. All of a batch's columns are views of one contiguous buffer
+laid out the same way in every batch of a recording (:class:`BatchLayout`, which the writer learns once), so a
+batch travels as that buffer, with no pickling (a step's values pickled one by one cost about as much as
+simulating a one-robot step; a batch's objects pickled, a few hundred µs of the sender holding the interpreter
+lock). The writer derives each topic's values for all the batch's steps at once (:meth:`StepBatch.values`).
 """
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -71,11 +74,16 @@ class ScanRows:
 
 
 class _Column(ABC):
-    """One value of a per-step topic, for the steps of a batch: a row per step."""
+    """One value of a per-step topic, for the steps of a batch: a row per step, in arrays that are views of the
+    batch's buffer."""
 
     @abstractmethod
-    def empty(self, size: int) -> _Column:
-        """A column like this one with room for ``size`` steps."""
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """Its arrays, a row per step (the batch's layout places them in its buffer)."""
+
+    @abstractmethod
+    def on(self, arrays: Sequence[np.ndarray]) -> _Column:
+        """A column like this one over ``arrays``, shaped like :meth:`arrays` but for another number of rows."""
 
     @abstractmethod
     def put(self, k: int, value: Any) -> None:
@@ -84,10 +92,6 @@ class _Column(ABC):
     @abstractmethod
     def rows(self, count: int) -> Any:
         """The first ``count`` steps' values at once, a leading axis per step: what a topic's layout reads."""
-
-    @abstractmethod
-    def head(self, count: int) -> _Column:
-        """The first ``count`` rows (views): what is pickled of a batch that is not full."""
 
 
 class _Array(_Column):
@@ -102,8 +106,11 @@ class _Array(_Column):
         value = np.asarray(value)
         return cls(np.empty((0, *value.shape), value.dtype))
 
-    def empty(self, size: int) -> _Array:
-        return _Array(np.empty((size, *self.data.shape[1:]), self.data.dtype))
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        return (self.data,)
+
+    def on(self, arrays: Sequence[np.ndarray]) -> _Array:
+        return _Array(*arrays)
 
     def put(self, k: int, value: Any) -> None:
         self.data[k] = value
@@ -111,23 +118,28 @@ class _Array(_Column):
     def rows(self, count: int) -> np.ndarray:
         return self.data[:count]
 
-    def head(self, count: int) -> _Array:
-        return _Array(self.data[:count])
-
 
 class _Scans(_Column):
     """The scans a step measured (:class:`fields.LatestScans`), packed: the measured rangers' beams end to end in
     one row, and which rangers measured."""
 
-    def __init__(self, first: tuple[int, ...], lengths: tuple[int, ...], size: int) -> None:
+    def __init__(self, first: tuple[int, ...], lengths: tuple[int, ...], ranges: np.ndarray,
+                 intensities: np.ndarray, measured: np.ndarray) -> None:
         self.first, self.lengths = first, lengths
-        self.beams = sum(lengths)
-        self.ranges = np.empty((size, self.beams), np.float32)
-        self.intensities = np.empty((size, self.beams), np.float32)
-        self.measured = np.zeros((size, len(lengths)), bool)
+        self.ranges, self.intensities, self.measured = ranges, intensities, measured
 
-    def empty(self, size: int) -> _Scans:
-        return _Scans(self.first, self.lengths, size)
+    @classmethod
+    def empty(cls, first: tuple[int, ...], lengths: tuple[int, ...]) -> _Scans:
+        """An empty column for the scans of rangers of ``lengths`` beams."""
+        beams = sum(lengths)
+        return cls(first, lengths, np.empty((0, beams), np.float32), np.empty((0, beams), np.float32),
+                   np.empty((0, len(lengths)), bool))
+
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        return self.ranges, self.intensities, self.measured
+
+    def on(self, arrays: Sequence[np.ndarray]) -> _Scans:
+        return _Scans(self.first, self.lengths, *arrays)
 
     def put(self, k: int, value: fields.LatestScans) -> None:
         beams = value.beams
@@ -146,19 +158,13 @@ class _Scans(_Column):
         return ScanRows(self.first, self.lengths, self.ranges[:count], self.intensities[:count],
                         self.measured[:count])
 
-    def head(self, count: int) -> _Scans:
-        head = _Scans(self.first, self.lengths, 0)
-        head.ranges, head.intensities, head.measured = (
-            self.ranges[:count], self.intensities[:count], self.measured[:count])
-        return head
-
 
 def _column(value: Any, sim: Simulation) -> _Column:
     """The column for a quantity's values, shaped after one step's ``value``."""
     if isinstance(value, fields.LatestScans):
         counts = [len(robot.rangers) for robot in sim.robots]
         first = tuple(int(i) for i in np.concatenate([[0], np.cumsum(counts)]))
-        return _Scans(first, tuple(r.sensor.samples for robot in sim.robots for r in robot.rangers), 0)
+        return _Scans.empty(first, tuple(r.sensor.samples for robot in sim.robots for r in robot.rangers))
     return _Array.like(value)
 
 
@@ -169,20 +175,61 @@ def _step_values(topic: Topic) -> StepValues:
     return topic.values
 
 
-class StepBatch:
-    """Up to ``size`` consecutive steps' quantities (:class:`~stage_sim.interface.topics.Quantity`), a column per
-    quantity the topics read: one the topics share (odom's and /tf's odometry poses, /clock's sim time, which
-    also times the steps) is copied once a step, and each topic's values are derived for all the steps at once
-    where they are read (:meth:`values`, in the writer process)."""
+HEAD = np.dtype(np.int64)
+"""The head of a batch's buffer: the number of steps it holds (none: the end of the batches, see
+:mod:`stage_sim.bags.writer`)."""
 
-    def __init__(self, quantities: tuple[Quantity, ...], columns: list[_Column],
-                 uses: list[tuple[Topic, tuple[int, ...]]], size: int) -> None:
+
+@dataclass(frozen=True)
+class BatchLayout:
+    """Where a batch's columns are in its one buffer, after the step count: fixed when a recording makes its first
+    batch, the same for all its batches, and sent to the writer once. A batch then travels as its buffer
+    alone, which the writer receives into a batch of its own, whose columns are already views of it: no
+    pickling per batch (it held the sender, and the interpreter lock, longer than the buffer's trip)."""
+
+    size: int
+    """Steps (rows) a batch has room for."""
+    columns: tuple[_Column, ...]
+    """Each quantity's column without rows: its arrays' dtypes and row shapes."""
+    offsets: tuple[tuple[int, ...], ...]
+    """Per column, where each of its arrays starts in the buffer (bytes, multiples of 8: any dtype's alignment)."""
+    nbytes: int
+    uses: tuple[tuple[Topic, tuple[int, ...]], ...]
+    """Per topic, the columns of the quantities its values are derived from."""
+
+    @classmethod
+    def of(cls, columns: Sequence[_Column], uses: Sequence[tuple[Topic, tuple[int, ...]]], size: int) -> BatchLayout:
+        """The columns' arrays end to end, each at a multiple of 8 bytes."""
+        at, offsets = HEAD.itemsize, []
+        for column in columns:
+            starts = []
+            for array in column.arrays():
+                starts.append(at)
+                at += -(-size * math.prod(array.shape[1:]) * array.itemsize // 8) * 8
+            offsets.append(tuple(starts))
+        return cls(size, tuple(columns), tuple(offsets), at, tuple(uses))
+
+
+class StepBatch:
+    """Up to ``layout.size`` consecutive steps' quantities (:class:`~stage_sim.interface.topics.Quantity`), a
+    column per quantity the topics read: one the topics share (odom's and /tf's odometry poses, /clock's sim
+    time, which also times the steps) is copied once a step, and each topic's values are derived for all the
+    steps at once where they are read (:meth:`values`, in the writer process)."""
+
+    def __init__(self, layout: BatchLayout, quantities: tuple[Quantity, ...] = ()) -> None:
+        """``quantities``: what :meth:`capture` copies into each column; none for the writer's batch, which is
+        only received into."""
+        self.layout = layout
         self._quantities = quantities
-        self._columns = [column.empty(size) for column in columns]
-        self._uses = uses
-        """Per topic, the columns of the quantities its values are derived from."""
+        self.buffer = np.empty(layout.nbytes, np.uint8)
+        """Everything the batch holds: the step count (:meth:`packed`), then every column's arrays."""
+        self._head = self.buffer[:HEAD.itemsize].view(HEAD)
+        self._columns = [
+            column.on([np.ndarray((layout.size, *array.shape[1:]), array.dtype, self.buffer, offset)
+                       for array, offset in zip(column.arrays(), offsets, strict=True)])
+            for column, offsets in zip(layout.columns, layout.offsets, strict=True)]
         self.count = 0
-        pairs = list(zip((quantity.read for quantity in quantities), self._columns, strict=True))
+        pairs = [(quantity.read, self._columns[i]) for i, quantity in enumerate(quantities)]
         self._arrays = [(read, column.data) for read, column in pairs if isinstance(column, _Array)]
         """What :meth:`capture` copies by a row assignment (inlined: a method call per quantity costs as much)."""
         self._packed = [(read, column) for read, column in pairs if not isinstance(column, _Array)]
@@ -195,19 +242,19 @@ class StepBatch:
             quantities += [q for q in _step_values(topic).reads if q not in quantities]
         uses = [(topic, tuple(quantities.index(q) for q in _step_values(topic).reads)) for topic in stepped]
         columns = [_column(quantity.read(sim), sim) for quantity in quantities]
-        return cls(tuple(quantities), columns, uses, size)
+        return cls(BatchLayout.of(columns, uses, size), tuple(quantities))
 
-    def empty(self, size: int) -> StepBatch:
+    def empty(self) -> StepBatch:
         """An empty batch like this one (the stepping side starts one as it hands the last over)."""
-        return StepBatch(self._quantities, self._columns, self._uses, size)
+        return StepBatch(self.layout, self._quantities)
 
     def clear(self) -> None:
-        """Empty this batch to fill it again (its arrays are kept: the sender has sent their contents)."""
+        """Empty this batch to fill it again (its buffer is kept: the sender has sent its contents)."""
         self.count = 0
 
     @property
     def full(self) -> bool:
-        return self.count == len(self._columns[0].data)
+        return self.count == self.layout.size
 
     def capture(self, sim: Simulation) -> None:
         """Copy the step just taken: the quantities of the topics the batch was made for."""
@@ -218,6 +265,16 @@ class StepBatch:
             column.put(k, read(sim))
         self.count += 1
 
+    def packed(self) -> np.ndarray:
+        """The batch as it travels: its whole buffer, the step count in its head (rows past the count hold
+        earlier steps or nothing: the receiver reads ``count`` rows)."""
+        self._head[0] = self.count
+        return self.buffer
+
+    def unpack(self) -> None:
+        """Take the step count from the buffer, just received into (:meth:`packed`'s)."""
+        self.count = int(self._head[0])
+
     @property
     def times(self) -> np.ndarray:
         """The sim time (µs) of each step held, in order."""
@@ -226,10 +283,4 @@ class StepBatch:
     def values(self) -> list[Any]:
         """Each topic's values for all the steps held (a leading axis per step), in the topics' order."""
         rows = [column.rows(self.count) for column in self._columns]
-        return [_step_values(topic).derive(*[rows[i] for i in columns]) for topic, columns in self._uses]
-
-    def __getstate__(self) -> dict[str, Any]:
-        """Only the rows filled travel to the writer, which reads them but copies no step (the quantities'
-        readers, functions, stay behind)."""
-        return {"count": self.count, "_quantities": (), "_arrays": [], "_packed": [], "_uses": self._uses,
-                "_columns": [column.head(self.count) for column in self._columns]}
+        return [_step_values(topic).derive(*[rows[i] for i in columns]) for topic, columns in self.layout.uses]

@@ -7,12 +7,13 @@ process of its own it runs on another core, and the stepping side only copies ea
 
 The process runs :func:`main` with ``STEPS REPORTS`` (:data:`stage_sim.bags.recorder.WRITER_MAIN`): a fresh
 interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would re-run
-the user's main script. STEPS and REPORTS are its two pipes' file descriptors; what goes through them is
-pickled by :mod:`multiprocessing.connection`, a batch's arrays out of band (:class:`BatchFrame`). It first
+the user's main script. STEPS and REPORTS are its two pipes' file descriptors, framed by
+:mod:`multiprocessing.connection`: reports and the plan are pickled, a batch of steps is sent as its buffer
+alone (:func:`send_batch`), laid out as the plan said (:class:`~stage_sim.bags.step_state.BatchLayout`). It first
 reads a :class:`WriterPlan` from the steps pipe and answers on the reports pipe with :class:`Opened` once the
 file is created and the latched messages are on disk, :class:`Failed` when the disk refuses a write (it then
 reads and discards what comes, so the simulation is never blocked by a dead recording), and :class:`Closed` at
-the end. It reads lists of steps until :class:`Finish`, or until the pipe ends without one (the simulation was
+the end. It reads batches of steps until :class:`Finish`, or until the pipe ends without one (the simulation was
 killed): it then still writes the summary, so a kill -9 of the simulator leaves a complete bag of every step
 it had sent. It ignores SIGINT and SIGTERM: Ctrl-C in a terminal reaches the whole process group, and the
 simulation's own handler closes the recording in order.
@@ -21,7 +22,6 @@ simulation's own handler closes the recording in order.
 from __future__ import annotations
 
 import contextlib
-import pickle
 import signal
 import traceback
 from dataclasses import dataclass, field
@@ -31,7 +31,7 @@ from pathlib import Path
 from stage_sim.bags.container import McapBag
 from stage_sim.bags.errors import BagError
 from stage_sim.bags.step_messages import StepMessages
-from stage_sim.bags.step_state import StepBatch
+from stage_sim.bags.step_state import HEAD, BatchLayout, StepBatch
 from stage_sim.bags.topics import Topic
 
 
@@ -46,41 +46,34 @@ class WriterPlan:
     static: list[tuple[str, int, bytes]]
     """The latched messages, serialised (/tf_static, /map)."""
     messages: StepMessages
-
-
-@dataclass(frozen=True)
-class BatchFrame:
-    """A :class:`StepBatch` as it goes down the pipe: its pickle (protocol 5) without its arrays, which follow
-    as ``buffers`` byte messages of their own. PEP 574's out-of-band buffers: neither side copies the arrays
-    (a 100-robot step holds 200 kB of beams) into or out of a pickle."""
-
-    pickle: bytes
-    buffers: int
-
-
-IN_BAND_BYTES = 4096
-"""Arrays smaller than this travel inside the pickle (a message of their own would cost more)."""
+    batches: BatchLayout
+    """How every batch sent is laid out: the writer receives each into a batch of this layout."""
 
 
 def send_batch(steps: Connection, batch: StepBatch) -> None:
-    """Send ``batch`` as a :class:`BatchFrame` and its arrays (raises OSError when the writer is gone)."""
-    buffers: list[pickle.PickleBuffer] = []
-
-    def out_of_band(buffer: pickle.PickleBuffer) -> bool:
-        if buffer.raw().nbytes < IN_BAND_BYTES:
-            return True
-        buffers.append(buffer)
-        return False
-
-    frame = BatchFrame(pickle.dumps(batch, protocol=5, buffer_callback=out_of_band), len(buffers))
-    steps.send(frame)
-    for buffer in buffers:
-        steps.send_bytes(buffer.raw())
+    """Send ``batch`` as one message, its buffer: the pipe's write takes it from the batch's memory and drops
+    the interpreter lock meanwhile (raises OSError when the writer is gone)."""
+    steps.send_bytes(batch.packed())
 
 
-def _receive_batch(steps: Connection, frame: BatchFrame) -> StepBatch:
-    """The batch ``frame`` starts (its arrays are read-only views of the bytes received)."""
-    return pickle.loads(frame.pickle, buffers=[steps.recv_bytes() for _ in range(frame.buffers)])
+def send_finish(steps: Connection, finish: Finish) -> None:
+    """End the batches (a head of no steps, which no batch sent has) and send ``finish``."""
+    steps.send_bytes(bytes(HEAD.itemsize))
+    steps.send(finish)
+
+
+def receive_batch(steps: Connection, batch: StepBatch) -> Finish | None:
+    """Receive the next batch into ``batch``, whose columns are views of its buffer: nothing to unpickle or
+    rebuild. At the end of the batches, the :class:`Finish` that follows. Raises EOFError or OSError when the
+    sender ended first, maybe in the middle of a batch (Connection reads a whole message before it copies it
+    into the buffer: a batch cut short leaves nothing of itself)."""
+    size = steps.recv_bytes_into(batch.buffer)
+    batch.unpack()
+    if not batch.count:
+        return steps.recv()
+    if size != batch.buffer.nbytes:  # a bug: the sender's batches are laid out otherwise
+        raise ValueError(f"a batch of {size} bytes came, one of {batch.buffer.nbytes} was expected")
+    return None
 
 
 @dataclass(frozen=True)
@@ -180,7 +173,7 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
             _report(reports, Opened(f"cannot write bag {plan.path}: {exc.strerror or exc}"))
             return
         _report(reports, Opened(None))
-        metadata = _write_steps(writer, steps)
+        metadata = _write_steps(writer, steps, StepBatch(plan.batches))
         if writer.error is None:
             try:
                 bag.finish(metadata)
@@ -192,16 +185,15 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
         _report(reports, Closed(writer.count, traceback.format_exc()))
 
 
-def _write_steps(writer: _Writer, steps: Connection) -> dict[str, str]:
-    """Write what comes until :class:`Finish` (its metadata) or the end of the pipe (the sender was killed)."""
+def _write_steps(writer: _Writer, steps: Connection, batch: StepBatch) -> dict[str, str]:
+    """Write what comes, received into ``batch`` each time, until :class:`Finish` (its metadata) or the end of the
+    pipe (the sender was killed)."""
     while True:
         try:
-            item = steps.recv()
-            if isinstance(item, BatchFrame):
-                item = _receive_batch(steps, item)
+            finish = receive_batch(steps, batch)
         except (EOFError, OSError):  # OSError: the sender was killed in the middle of a batch
             stopped = "its start" if writer.last_us is None else f"sim time {writer.last_us / 1e6:g} s"
             return {"interrupted": f"the simulation ended without closing the bag after {stopped}"}
-        if isinstance(item, Finish):
-            return item.metadata
-        writer.steps(item)
+        if finish is not None:
+            return finish.metadata
+        writer.steps(batch)

@@ -16,6 +16,7 @@ from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world, load_world_text
 from tests.bags.test_recorder import COMMANDS, names_of
 from tests.bags.test_step_state import WORLD as RATES_WORLD
+from tests.bags.test_step_state import travelled
 from tests.bags.worlds import two_robot_world
 
 STEPPED = [t for t in topics.PUBLISHED if t.timing is not Timing.START]
@@ -63,7 +64,7 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen, w
                                                                                           strict=True)]
             expected.append([None if msg is None else bytes(TYPESTORE.serialize_cdr(msg, topic.msgtype))
                              for msg in filled])
-        received = pickle.loads(pickle.dumps(batch))
+        received = travelled(batch)
         (values,) = received.values()
         refilled = layout.refill(values, received.times)
         assert refilled == expected

@@ -1,14 +1,18 @@
-"""A batch of steps, pickled as it travels to the bag writer, gives back every step's values as the
-simulation had them: poses, times and which rangers measured what (rangers at different rates, a robot
-without any)."""
+"""A batch of steps, sent as it travels to the bag writer (its buffer through a pipe, into the writer's batch of
+the same layout), gives back every step's values as the simulation had them: poses, times and which rangers
+measured what (rangers at different rates, a robot without any)."""
 
 from __future__ import annotations
 
 import pickle
+import threading
+from multiprocessing import Pipe
 
 import numpy as np
+import pytest
 
 from stage_sim.bags.step_state import StepBatch
+from stage_sim.bags.writer import receive_batch, send_batch
 from stage_sim.interface import topics
 from stage_sim.interface.names import robot_names
 from stage_sim.sim.simulation import Simulation
@@ -31,21 +35,44 @@ bot( pose [6.0 4.0 0 0] slow( pose [0.2 0 -0.1 0] ) )
 STEPPED = [t for t in topics.PUBLISHED if t.timing is not topics.Timing.START]
 
 
-def test_a_pickled_batch_gives_back_every_step(tmp_path) -> None:
+def travelled(batch: StepBatch, into: StepBatch | None = None) -> StepBatch:
+    """``batch`` as the writer gets it: sent through a pipe (by a thread: the pipe holds less than a batch) and
+    received ``into`` a batch of the layout the writer's plan brings (pickled), or a batch it received before."""
+    received = StepBatch(pickle.loads(pickle.dumps(batch.layout))) if into is None else into
+    receiving, sending = Pipe(duplex=False)
+    sender = threading.Thread(target=send_batch, args=(sending, batch))
+    sender.start()
+    assert receive_batch(receiving, received) is None
+    sender.join()
+    return received
+
+
+@pytest.mark.parametrize("refilled", [False, True])
+def test_a_sent_batch_gives_back_every_step(tmp_path, refilled) -> None:
+    """Also a batch not full (a hand-over after WAKE_S), refilled after a full one was sent: its buffer and the
+    writer's still hold the earlier batch's steps past the rows filled, which the writer does not read."""
     sim = Simulation(load_world_text(WORLD, str(tmp_path / "w.world")), seed=2)
     names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers)) for r in sim.robots]
     for robot in range(3):
         sim.set_velocity(robot, 0.3, 0.0, 0.2 * robot)
     batch = StepBatch.first(sim, names, STEPPED, 10)
+    received = None
+    if refilled:
+        for _ in range(10):
+            sim.step()
+            batch.capture(sim)
+        assert batch.full
+        received = travelled(batch)
+        batch.clear()
     expected = []
-    for _ in range(7):  # not full: only the rows filled travel
+    for _ in range(7):  # not full
         sim.step()
         batch.capture(sim)
         scans = {(r, k): (s.ranges.copy(), s.intensities.copy()) if s.stamp == sim.sim_time else None
                  for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
     assert not batch.full
-    received = pickle.loads(pickle.dumps(batch))
+    received = travelled(batch, received)
     assert received.count == 7
     values = dict(zip(STEPPED, received.values(), strict=True))
     np.testing.assert_array_equal(received.times, [time_us for time_us, *_ in expected])
@@ -88,7 +115,7 @@ def test_topics_reading_the_same_quantity_share_one_copy_and_derived_values_are_
         sim.step()
         batch.capture(sim)
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_poses.copy(), sim.true_velocities))
-    received = pickle.loads(pickle.dumps(batch))
+    received = travelled(batch)
     odometry, truth, tf = received.values()
     assert np.shares_memory(odometry[0], tf)
     np.testing.assert_array_equal(received.times, [time_us for time_us, *_ in expected])
