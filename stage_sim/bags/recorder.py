@@ -101,7 +101,7 @@ class BagRecorder:
         self._messages = builder.stepping
         step_bytes = 8 * sum(r.sensor.samples for robot in sim.robots for r in robot.rangers) + 200 * len(sim.robots)
         batch_steps = max(1, min(BATCH_STEPS, BATCH_BYTES // step_bytes))
-        self._pending = StepBatch.first(sim, names, self._messages.stepped, batch_steps)
+        self._pending = StepBatch.first(sim, self._messages.stepped, batch_steps)
         plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping,
                           self._pending.layout)
         try:

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from stage_sim.interface import fields
-from stage_sim.interface.names import RobotNames
 from stage_sim.interface.topics import SIM_TIME_US, Quantity, StepValues, Topic
 
 if TYPE_CHECKING:
@@ -235,7 +234,7 @@ class StepBatch:
         self._packed = [(read, column) for read, column in pairs if not isinstance(column, _Array)]
 
     @classmethod
-    def first(cls, sim: Simulation, names: Sequence[RobotNames], stepped: Sequence[Topic], size: int) -> StepBatch:
+    def first(cls, sim: Simulation, stepped: Sequence[Topic], size: int) -> StepBatch:
         """An empty batch for the values of the ``stepped`` topics, shaped after the simulation's."""
         quantities = [SIM_TIME_US]  # the steps' times, whatever the topics
         for topic in stepped:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -69,10 +69,10 @@ def scan_arrays(scan: Scan) -> tuple[np.ndarray, np.ndarray]:
 
 
 
-@dataclass(frozen=True)
-class LatestScans:
+class LatestScans(NamedTuple):
     """Every ranger's latest scan (``scans[robot][ranger]``) and the step's sim time: a ranger publishes only
-    in the steps it measured in (rangers slower than interval_sim skip steps)."""
+    in the steps it measured in (rangers slower than interval_sim skip steps). A named tuple: stageros and a
+    recording make one every step, and a frozen dataclass costs a microsecond to make."""
 
     scans: list[list[Scan]]
     time: float

@@ -54,7 +54,7 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen, w
             sim.set_velocity(robot, *command)
     compared = 0
     for size in (5, 1, 4, 2):  # batches of several sizes, the layout's buffer grown and reused
-        batch = StepBatch.first(sim, names, [topic], size)
+        batch = StepBatch.first(sim, [topic], size)
         expected = []
         for _ in range(size):
             sim.step()

@@ -14,7 +14,6 @@ import pytest
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.writer import receive_batch, send_batch
 from stage_sim.interface import topics
-from stage_sim.interface.names import robot_names
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
 from tests.bags.worlds import REPO
@@ -52,10 +51,9 @@ def test_a_sent_batch_gives_back_every_step(tmp_path, refilled) -> None:
     """Also a batch not full (a hand-over after WAKE_S), refilled after a full one was sent: its buffer and the
     writer's still hold the earlier batch's steps past the rows filled, which the writer does not read."""
     sim = Simulation(load_world_text(WORLD, str(tmp_path / "w.world")), seed=2)
-    names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers)) for r in sim.robots]
     for robot in range(3):
         sim.set_velocity(robot, 0.3, 0.0, 0.2 * robot)
-    batch = StepBatch.first(sim, names, STEPPED, 10)
+    batch = StepBatch.first(sim, STEPPED, 10)
     received = None
     if refilled:
         for _ in range(10):
@@ -105,9 +103,8 @@ def test_topics_reading_the_same_quantity_share_one_copy_and_derived_values_are_
     """odom and /tf share the odometry poses; ground truth's velocities, zero while stalled, are derived from the
     copied velocities and stall flags after the batch's trip (robots without rangers, no scan topic)."""
     sim = Simulation(load_world_text(AGAINST_A_WALL, "wall.world"), seed=0)
-    names = [robot_names(r.index, r.name, len(sim.robots), len(r.rangers)) for r in sim.robots]
     stepped = [topics.ODOM, topics.GROUND_TRUTH, topics.TF]
-    batch = StepBatch.first(sim, names, stepped, 12)
+    batch = StepBatch.first(sim, stepped, 12)
     expected = []
     for _ in range(12):
         sim.set_velocity(0, 1.0, 0.0, 0.0)  # into the wall: it stalls

@@ -31,7 +31,7 @@ def test_a_batch_cut_short_ends_the_input_and_the_bag_is_still_finished(tmp_path
     steps_in, steps_out = os.pipe()
     reports_in, reports_out = os.pipe()
     steps, reports = Connection(steps_out, readable=False), Connection(reports_in, writable=False)
-    batch = StepBatch.first(sim, names, builder.stepping.stepped, 5)
+    batch = StepBatch.first(sim, builder.stepping.stepped, 5)
     writer = threading.Thread(target=write_bag, args=(
         WriterPlan(path, topics, 0.0, list(builder.static(sim)), builder.stepping, batch.layout),
         Connection(steps_in, writable=False), Connection(reports_out, readable=False)))
