@@ -22,6 +22,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
+from stage_sim.maps.raster import StaticBody
 from stage_sim.sim.simulation import Simulation
 
 #: Candidates drawn per batch, and batches tried, before every valid cell is looked at.
@@ -118,15 +119,12 @@ class FreeSpace:
             return self._blocked_of(sim)
         bands = {sim.robots[i].z_band for i in self._robots}
         blocked = self._blocked.copy()
+        mark = _mark_filled
         if sim.kernels == "numba":
-            from stage_sim.envs.free_space_kernels import mark_filled
+            from stage_sim.envs.free_space_kernels import mark_filled as mark
         for body in bodies[len(self._bodies):]:
-            if not any(body.blocks(*band) for band in bands):
-                continue
-            if sim.kernels == "numba":
-                mark_filled(blocked, body)
-            else:
-                blocked.ravel()[body.cells] = True
+            if any(body.blocks(*band) for band in bands):
+                mark(blocked, body)
         return blocked
 
     def _index(self, valid: np.ndarray, compiled: bool) -> None:
@@ -217,6 +215,12 @@ class FreeSpace:
         if excluded:
             return np.concatenate([c for r, c in enumerate(self._region_cells, 1) if r not in excluded] or [[]])
         return self.cells
+
+
+def _mark_filled(blocked: np.ndarray, body: StaticBody) -> None:
+    """Set in ``blocked`` the cells of ``body``'s filled footprint (the numpy reference of
+    :func:`~stage_sim.envs.free_space_kernels.mark_filled`)."""
+    blocked.ravel()[body.cells] = True
 
 
 def _clusters(mask: np.ndarray) -> list[tuple[slice, slice]]:

