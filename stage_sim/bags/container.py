@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -177,21 +177,28 @@ class McapBag:
             raise self._file.error
         return result
 
-    def write(self, log_time_ns: int, messages: list[tuple[str, bytes]]) -> None:
-        """Add messages (topic, CDR bytes) of one time (log and publish time = their sim stamp): a step's;
-        raises OSError when the disk refuses."""
-        log = self._log
-        for topic, data in messages:
-            log[topic](data, log_time_ns)
+    def write(self, log_times_ns: Sequence[int], topics: Sequence[str], messages: Sequence[bytes | None]) -> None:
+        """Add the messages (CDR bytes) of some steps: ``messages`` holds each step's in turn, one for each topic
+        of ``topics`` (None: no message there), stamped (log and publish time) with the step's log time.
+        Raises OSError when the disk refuses: the library reports that only when the chunk is written, so the
+        batch from its first step on may be lost. One loop for the whole batch: the writer's Python per
+        message was most of its CPU."""
+        logs = [self._log[topic] for topic in topics]
+        per_step = len(logs)
+        span = self._chunk_span_ns
+        for at, log_time in zip(range(0, len(messages), per_step), log_times_ns, strict=True):
+            for log, data in zip(logs, messages[at:at + per_step], strict=True):
+                if data is not None:
+                    log(data, log_time)
+            if span is None:
+                continue
+            if self._chunk_start_ns is None:
+                self._chunk_start_ns = log_time
+            elif log_time - self._chunk_start_ns >= span:
+                self.flush()
         self._file.commit()
         if self._file.error is not None:  # the library only logs a failed write of a chunk
             raise self._file.error
-        if self._chunk_span_ns is None:
-            return
-        if self._chunk_start_ns is None:
-            self._chunk_start_ns = log_time_ns
-        elif log_time_ns - self._chunk_start_ns >= self._chunk_span_ns:
-            self.flush()
 
     def flush(self) -> None:
         """Close the open chunk and hand everything to the operating system (survives a kill -9 from now on);

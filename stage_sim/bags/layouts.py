@@ -87,6 +87,9 @@ class _Block:
                 at = start + step * self.stride
                 self.buffer[at:at + len(template)] = template
         self.spans = [(start, start + len(template)) for start, template in zip(self.starts, templates, strict=True)]
+        self._every = [(begin + at, end + at) for at in range(0, steps * self.stride, self.stride)
+                       for begin, end in self.spans]
+        """Every message's span in the buffer, step after step (what :meth:`messages` cuts)."""
         self.f64 = np.frombuffer(self.buffer, "<f8", len(self.buffer) // 8)
         self.f32 = np.frombuffer(self.buffer, "<f4", len(self.buffer) // 4)
         self.i32 = np.frombuffer(self.buffer, "<i4", len(self.buffer) // 4)
@@ -105,11 +108,11 @@ class _Block:
         sec, nanosec = fields.stamp_parts(np.asarray(sim_times_us, dtype=np.int64)[:, None])
         self.i32[at], self.u32[at + 1] = sec, nanosec
 
-    def messages(self, steps: int) -> list[list[bytes | None]]:
-        """Every message's bytes as they are now, per step of the first ``steps``."""
+    def messages(self, steps: int) -> list[bytes | None]:
+        """Every message's bytes as they are now, of the first ``steps`` steps, step after step (one list: the
+        writer's Python per message was most of its CPU)."""
         data = bytes(self.buffer[:HEADER + steps * self.stride])
-        return [[data[start + step:end + step] for start, end in self.spans]
-                for step in range(0, steps * self.stride, self.stride)]
+        return [data[begin:end] for begin, end in self._every[:steps * len(self.spans)]]
 
 
 class Layout(ABC):
@@ -140,9 +143,9 @@ class Layout(ABC):
         return {"stamp": block.index(every, [HEADER] * len(self._templates), 4)}
 
     @abstractmethod
-    def refill(self, values: Any, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
-        """Per step, each endpoint's message bytes for the steps' ``values`` (the topic's :attr:`Topic.values`
-        with a leading axis per step), None for an endpoint that publishes nothing in that step."""
+    def refill(self, values: Any, sim_times_us: np.ndarray) -> list[bytes | None]:
+        """Each endpoint's message bytes for the steps' ``values`` (the topic's :attr:`Topic.values` with a
+        leading axis per step), step after step, None for an endpoint that publishes nothing in that step."""
 
     def count(self, values: Any) -> int:
         """How many messages :meth:`refill` makes of ``values`` (without making them)."""
@@ -157,7 +160,7 @@ def _steps_of(values: Any) -> Any:
 class ClockLayout(Layout):
     """rosgraph_msgs/Clock: the stamp is the message."""
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         block.stamp(self._fields["stamp"][:steps], sim_times_us)
@@ -170,7 +173,7 @@ class BoolLayout(Layout):
     def _index(self, block: _Block) -> dict[str, np.ndarray]:
         return {"data": block.index(range(len(self._templates)), [HEADER] * len(self._templates), 1)}
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         block.u8[self._fields["data"][:steps]] = values[:, self._robots]
@@ -186,7 +189,7 @@ class OdometryLayout(Layout):
         return {**super()._index(block), "pose": block.index(every, poses, 8),
                 "twist": block.index(every, [pose + (7 + 36) * 8 for pose in poses], 8)}  # after the covariance
 
-    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_times_us: np.ndarray) -> list[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         poses, velocities = values[0][:, self._robots], values[1][:, self._robots]
@@ -236,11 +239,12 @@ class ScanLayout(Layout):
             self._gather = (rows.first, rows.lengths, gather)
         return self._gather[2]
 
-    def refill(self, values: ScanRows, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+    def refill(self, values: ScanRows, sim_times_us: np.ndarray) -> list[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         if not values.measured.all():
-            return [self._refill_step(values.row(k), k, time) for k, time in enumerate(sim_times_us.tolist())]
+            return [data for k, time in enumerate(sim_times_us.tolist())
+                    for data in self._refill_step(values.row(k), k, time)]
         gather = self._in_rows(values)
         ranges, intensities = (values.ranges, values.intensities) if gather is None else (
             values.ranges[:, gather], values.intensities[:, gather])
@@ -288,7 +292,7 @@ class TransformsLayout(Layout):
                 offset = translation + 7 * 8
         return {"stamp": block.index(message, stamps, 4), "translation": block.index(message, translations, 8)}
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[list[bytes | None]]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         poses = np.tile(values, (1, len(self._templates), 1))  # every message holds every robot's

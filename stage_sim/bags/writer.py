@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import signal
 import traceback
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection
 from pathlib import Path
@@ -117,24 +118,24 @@ class _Writer:
         """The sim time of the last step written."""
         self.error: str | None = None
 
-    def write(self, log_time: int, messages: list[tuple[str, bytes]]) -> None:
-        self.bag.write(log_time, messages)
-        self.count += len(messages)
+    def write(self, log_times: Sequence[int], topics: Sequence[str], messages: Sequence[bytes | None]) -> None:
+        self.bag.write(log_times, topics, messages)
+        self.count += len(messages) - messages.count(None)
 
     def steps(self, batch: StepBatch) -> None:
         """Write the batch's steps, unless an earlier write failed (then they are dropped: the recording has
         stopped)."""
         if self.error is not None:
             return
-        for log_time, messages in self._messages.steps(batch):
-            try:
-                self.write(log_time, messages)
-            except OSError as exc:
-                self.error = f"{exc.strerror or exc} at sim time {log_time / 1e9:g} s"
-                self.bag.abort()
-                _report(self._reports, Failed(self.error))
-                return
-            self.last_us = log_time // 1000
+        log_times, messages = self._messages.steps(batch)
+        try:
+            self.write(log_times, self._messages.names, messages)
+        except OSError as exc:
+            self.error = f"{exc.strerror or exc} at sim time {log_times[0] / 1e9:g} s"
+            self.bag.abort()
+            _report(self._reports, Failed(self.error))
+            return
+        self.last_us = log_times[-1] // 1000
 
 
 def main(argv: list[str]) -> None:
@@ -166,7 +167,7 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
     try:
         try:
             for topic, log_time, data in plan.static:
-                writer.write(log_time, [(topic, data)])
+                writer.write((log_time,), (topic,), (data,))
             bag.flush()  # the latched messages are on disk before the first step: a kill -9 keeps them
         except OSError as exc:
             bag.abort()
