@@ -55,8 +55,12 @@ def resolve_threads(requested: int | None = None, default: int = 1) -> int:
         value = int(env) if env else default
     if value < 0:
         raise ValueError(f"threads must be >= 0, not {value}")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return cores if value == 0 else value
+    return available_cores() if value == 0 else value
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its affinity, e.g. under ``taskset``)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 @cache

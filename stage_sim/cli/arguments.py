@@ -54,8 +54,9 @@ def add_duration_argument(parser: argparse.ArgumentParser) -> None:
 
 def add_kernel_arguments(parser: argparse.ArgumentParser, paced: bool = True) -> None:
     """``--kernels`` and ``--threads``, the same on every command that simulates; a ``paced`` command (one with
-    ``--speedup``) takes all cores when unpaced (:func:`stage_sim.runs.pacing.threads_for_run`)."""
-    threads_default = "1, all cores with --speedup 0" if paced else "1"
+    ``--speedup``) takes all cores when unpaced, all but one when it records a bag
+    (:func:`stage_sim.runs.pacing.threads_for_run`)."""
+    threads_default = "1, all cores with --speedup 0 (all but one when recording a bag)" if paced else "1"
     parser.add_argument("--kernels", choices=KERNELS, default=None,
                         help=f"hot-path implementation, identical results (default: ${KERNELS_ENV} or numba)")
     parser.add_argument("--threads", type=int, default=None,

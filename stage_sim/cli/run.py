@@ -51,7 +51,7 @@ def _run(args: argparse.Namespace) -> int:
 
     description = load_world(args.world)
     speedup = run_speedup(args.speedup, description.settings.speedup)
-    threads = threads_for_run(args.threads, speedup)
+    threads = threads_for_run(args.threads, speedup, recording=bool(args.bag))
     sim = Simulation(description, seed=args.seed, kernels=args.kernels, threads=threads)
     for warning in sim.warnings:
         print(f"stage_sim run: {warning}", file=sys.stderr)

@@ -52,8 +52,10 @@ class WanderSession:
     the world's ``quit_time`` or ``duration`` sim seconds, whichever comes first. ``speedup`` None: the world's."""
 
     def __init__(self, world: str, speedup: float | None, seed: int | None, duration: float | None = None,
-                 context: Context | None = None) -> None:
-        self.stage = StageRos(world, speedup=speedup, seed=seed, autostep=False, duration=duration, context=context)
+                 context: Context | None = None, recording: bool = False) -> None:
+        """``recording``: a bag will record the simulator (which then leaves a core to its writer)."""
+        self.stage = StageRos(world, speedup=speedup, seed=seed, autostep=False, duration=duration, context=context,
+                              recording=recording)
         sim = self.stage.sim
         self.wanderers = []
         for index, (robot, names) in enumerate(zip(sim.robots, self.stage.names, strict=True)):
@@ -161,7 +163,7 @@ def wander_main(argv: list[str], prog: str, default_world: str, description: str
     session = None
     try:
         with stop_requests() as stop:
-            session = WanderSession(args.world, args.speedup, args.seed, args.duration)
+            session = WanderSession(args.world, args.speedup, args.seed, args.duration, recording=bool(args.bag))
             with (recording(session.stage, args, prog), bag_recording(session.stage, args, prog) as recorder,
                   viewing(session.stage, args)):
                 session.run(stop)

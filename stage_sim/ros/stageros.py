@@ -71,11 +71,13 @@ class StageRos(Node):
     def __init__(
         self, world: str | Path | None = None, *, speedup: float | None = None, seed: int | None = None,
         use_model_names: bool | None = None, node_name: str = "stageros", autostep: bool = True,
-        kernels: str | None = None, threads: int | None = None, duration: float | None = None, **kwargs,
+        kernels: str | None = None, threads: int | None = None, duration: float | None = None,
+        recording: bool = False, **kwargs,
     ) -> None:
         """Load the world and advertise everything; ``autostep=False`` leaves stepping to the caller
         (:meth:`step_once`), for tests and programs that drive the simulation themselves. ``threads``
-        defaults to 1 in real time and to all cores with ``speedup <= 0``. The run ends at the world's
+        defaults to 1 in real time and to all cores with ``speedup <= 0`` (all but one when ``recording`` a
+        bag: :func:`~stage_sim.runs.pacing.threads_for_run`). The run ends at the world's
         ``quit_time`` or after ``duration`` sim seconds, whichever comes first."""
         super().__init__(node_name, **kwargs)
         (world_param,) = declare_parameters(self, [ParameterSpec(
@@ -101,7 +103,7 @@ class StageRos(Node):
 
         self.sim = Simulation(description, seed=None if seed_value < 0 else seed_value,
                               watchdog_timeout=params["base_watchdog_timeout"], kernels=kernels,
-                              threads=threads_for_run(threads, speedup))
+                              threads=threads_for_run(threads, speedup, recording))
         for warning in self.sim.warnings:
             self.get_logger().warning(str(warning))
         robots = self.sim.robots

@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
         with stop_requests() as stop, core_log_on(rclpy.logging.get_logger("stageros")):
             node = StageRos(
                 args.world, speedup=args.speedup, seed=args.seed, use_model_names=args.use_model_names or None,
-                kernels=args.kernels, threads=args.threads)
+                kernels=args.kernels, threads=args.threads, recording=bool(args.bag))
             executor = SingleThreadedExecutor()
             executor.add_node(node)
             with (recording(node, args, "stageros"), viewing(node, args),

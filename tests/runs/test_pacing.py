@@ -148,3 +148,15 @@ def test_a_paced_run_takes_one_thread_an_unpaced_one_every_core(monkeypatch):
     assert pacing.os.environ["OMP_WAIT_POLICY"] == "PASSIVE"  # paced on several threads: idle workers sleep
     monkeypatch.setenv(THREADS_ENV, "3")
     assert pacing.threads_for_run(None, 0.0) == 3
+    assert pacing.threads_for_run(None, 0.0, recording=True) == 3  # the user's choice stands
+
+
+def test_an_unpaced_recording_leaves_a_core_to_the_bag_writer(monkeypatch):
+    monkeypatch.delenv(THREADS_ENV, raising=False)
+    monkeypatch.setattr(pacing.os, "sched_getaffinity", lambda pid: {0, 1, 2, 3})  # a 4-core machine
+    assert pacing.threads_for_run(None, 0.0, recording=True) == 3
+    assert pacing.threads_for_run(None, 0.0, recording=False) == 4
+    assert pacing.threads_for_run(None, 2.0, recording=True) == 1  # paced: one thread anyway
+    assert pacing.threads_for_run(4, 0.0, recording=True) == 4  # asked for
+    monkeypatch.setattr(pacing.os, "sched_getaffinity", lambda pid: {0})
+    assert pacing.threads_for_run(None, 0.0, recording=True) == 1
