@@ -134,10 +134,10 @@ class FreeSpace:
         if compiled:
             from stage_sim.envs.free_space_kernels import label8
 
-            self.regions, count, self.cells = label8(valid)
+            self.regions, count = label8(valid)
         else:
             self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
-            self.cells = np.flatnonzero(valid)
+        self.cells = np.flatnonzero(valid)
         if count == 1:  # the common case needs no sorting by region
             self._region_cells = [self.cells]
         else:

@@ -26,14 +26,11 @@ from stage_sim.maps.raster import StaticBody
 _JIT = {"cache": True, "nogil": True}
 
 
-def label8(valid: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
-    """``scipy.ndimage.label(valid, structure=np.ones((3, 3)))``: int32 labels (H, W) and their count, and
-    ``np.flatnonzero(valid)``, gathered by the labelling's last pass (numpy's own pass over a 30 m world at
-    5 cm took about as long as the labelling)."""
+def label8(valid: np.ndarray) -> tuple[np.ndarray, int]:
+    """``scipy.ndimage.label(valid, structure=np.ones((3, 3)))``: int32 labels (H, W) and their count."""
     labels = np.zeros(valid.shape, dtype=np.int32)
-    cells = np.empty(valid.size, dtype=np.int64)
-    count, found = label_into(np.ascontiguousarray(valid, dtype=np.bool_), labels, cells)
-    return labels, int(count), cells[:found]
+    count = label_into(np.ascontiguousarray(valid, dtype=np.bool_), labels)
+    return labels, int(count)
 
 
 @numba.njit(inline="always", **_JIT)
@@ -57,10 +54,9 @@ def _join(parent, a, b):
 
 
 @numba.njit(**_JIT)
-def label_into(valid, labels, cells):
+def label_into(valid, labels):
     """Write the 8-connected regions of ``valid`` (H, W) into the zeroed ``labels``, numbered 1.. in the raster
-    order of each region's first cell, and the flat index of every valid cell, in order, into ``cells``;
-    returns how many regions and cells there are."""
+    order of each region's first cell; returns how many there are."""
     height, width = valid.shape
     parent = np.empty(height * width + 1, dtype=np.int32)
     made = 0
@@ -96,15 +92,10 @@ def label_into(valid, labels, cells):
             final[label] = count
         else:
             final[label] = final[root]  # a root is older than every label it holds: numbered already
-    found = 0
     for r in range(height):
         for c in range(width):
-            label = labels[r, c]
-            if label:
-                labels[r, c] = final[label]
-                cells[found] = r * width + c
-                found += 1
-    return count, found
+            labels[r, c] = final[labels[r, c]]
+    return count
 
 
 def clear_near(valid: np.ndarray, added: np.ndarray, cells: np.ndarray, offsets: np.ndarray) -> None:
