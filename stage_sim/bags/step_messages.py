@@ -66,9 +66,10 @@ class StepMessages:
         """What takes the messages of ``steps`` steps, given every topic's (step after step) one topic after
         another, in step order."""
         if steps not in self._order:
-            firsts = [0, *accumulate(steps * len(channel.names) for channel in self.channels)]
+            firsts = accumulate((steps * len(channel.names) for channel in self.channels[:-1]), initial=0)
+            starts = list(zip(firsts, self.channels, strict=True))
             order = [first + step * len(channel.names) + endpoint for step in range(steps)
-                     for first, channel in zip(firsts, self.channels, strict=False)
+                     for first, channel in starts
                      for endpoint in range(len(channel.names))]
             # itemgetter returns a tuple, except of one index
             self._order[steps] = itemgetter(*order) if len(order) > 1 else lambda messages: messages[:len(order)]

@@ -129,7 +129,8 @@ def threads_for_run(requested: int | None, speedup: float, recording: bool = Fal
     and the other waited: 100 robots on 2 cores recorded at 3.06 s of wall time on 2 threads, 2.47 s on 1,
     best of 3 alternated). Idle workers of a paced run sleep (:func:`let_idle_threads_sleep`). What
     ``stageros``, ``stage_sim run``, ``stage_sim view`` and the launch scripts use."""
-    default = 1 if speedup > 0 else max(1, available_cores() - 1) if recording else 0
+    unpaced = max(1, available_cores() - 1) if recording else 0  # 0: all cores
+    default = 1 if speedup > 0 else unpaced
     threads = resolve_threads(requested, default=default)
     let_idle_threads_sleep(speedup > 0, threads)
     return threads
