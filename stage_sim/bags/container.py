@@ -190,6 +190,8 @@ class McapBag:
         message was most of its CPU."""
         logs = [self._log[topic] for topic in topics]
         per_step = len(logs)
+        if not per_step:  # a bag of latched topics only: the steps add nothing
+            return
         span = self._chunk_span_ns
         for at, log_time in zip(range(0, len(messages), per_step), log_times_ns, strict=True):
             for log, data in zip(logs, messages[at:at + per_step], strict=True):

@@ -58,8 +58,8 @@ class StepMessages:
         refilled = [channel.layout.refill(values, times) for channel, values
                     in zip(self.channels, batch.values(), strict=True)]
         log_times = [fields.stamp_ns(time) for time in times.tolist()]
-        if len(refilled) == 1:
-            return log_times, refilled[0]
+        if len(refilled) <= 1:  # one topic's are in step order already; no topic (only latched ones): none
+            return log_times, refilled[0] if refilled else []
         return log_times, self._in_step_order(len(log_times))(list(chain.from_iterable(refilled)))
 
     def _in_step_order(self, steps: int) -> Callable[[list[bytes | None]], Sequence[bytes | None]]:
