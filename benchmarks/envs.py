@@ -17,7 +17,9 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   step, episodes reset as they end): ``kernel_us`` inside the compiled step (moves, contacts and the ray walk),
   ``step_glue_us`` the rest of ``Simulation.step`` (Python and numpy around it), ``env_us`` the env's own
   work per step (actions, goal, observation, reward, info), ``reset_us`` the resets' time per step
-  (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement).
+  (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement). The same for the vector
+  env of ``--worlds`` worlds, per world step (each world still steps its own simulation: what a step of all
+  the worlds in one compiled call could take away is the glue, and part of the env's work).
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -99,18 +101,25 @@ def parallel_speed(robots: int, seconds: float) -> dict:
             "core_share": round(core[0] / elapsed, 3)}
 
 
-def breakdown(seconds: float) -> dict:
-    """A one-robot env step's time by part (see the module's docstring), on the compiled kernels."""
+def breakdown(seconds: float, worlds: int = 0) -> dict:
+    """Where an env step's time goes (see the module's docstring), on the compiled kernels: ``NavigateEnv``, or
+    with ``worlds`` the vector env of that many one-robot worlds (then per world step, its autoresets timed
+    where they happen, inside its ``step``)."""
+    from stage_sim.envs.task import NavigationTask
     from stage_sim.sim import fused_kernels
-    from stage_sim.sim.simulation import Simulation
 
-    env = NavigateEnv(scenario="obstacles", n_obstacles=8, obstacle_size=(0.3, 1.0), **ARENA)
+    scenario = {"scenario": "obstacles", "n_obstacles": 8, "obstacle_size": (0.3, 1.0), **ARENA}
+    env = NavigateVectorEnv(worlds, **scenario) if worlds else NavigateEnv(**scenario)
     env.reset(seed=0)
-    env.task.sim.wait_for_kernels()
+    for task in env.tasks if worlds else [env.task]:
+        task.sim.wait_for_kernels()
     rng = np.random.default_rng(1)
-    actions = np.stack([rng.uniform(0.0, 1.0, 1000), rng.uniform(-np.pi / 2, np.pi / 2, 1000)], -1).astype(np.float32)
+    count = max(worlds, 1)
+    actions = np.stack([rng.uniform(0.0, 1.0, (1000, count)), rng.uniform(-np.pi / 2, np.pi / 2, (1000, count))],
+                       -1).astype(np.float32)
     spent = {"kernel": 0.0, "step": 0.0, "reset": 0.0}
-    whole_step, step = fused_kernels.whole_step, Simulation.step
+    resets = 0
+    whole_step, step, reset = fused_kernels.whole_step, Simulation.step, NavigationTask.reset
 
     def timed_kernel(*args: object) -> object:
         start = time.perf_counter()
@@ -124,27 +133,36 @@ def breakdown(seconds: float) -> dict:
         step(sim)
         spent["step"] += time.perf_counter() - start
 
-    fused_kernels.whole_step, Simulation.step = timed_kernel, timed_step
+    def timed_reset(task: NavigationTask, generator: np.random.Generator) -> np.ndarray:
+        nonlocal resets
+        inside = spent["kernel"], spent["step"]
+        began = time.perf_counter()
+        observations = reset(task, generator)
+        spent["reset"] += time.perf_counter() - began
+        spent["kernel"], spent["step"] = inside  # a reset's own still step counts in the reset
+        resets += 1
+        return observations
+
+    fused_kernels.whole_step, Simulation.step, NavigationTask.reset = timed_kernel, timed_step, timed_reset
     try:
-        steps = resets = 0
+        steps = 0
         start = time.perf_counter()
         while time.perf_counter() - start < seconds:
-            _, _, terminated, truncated, _ = env.step(actions[steps % len(actions)])
-            steps += 1
-            if terminated or truncated:
-                inside = spent["kernel"], spent["step"]
-                began = time.perf_counter()
-                env.reset()
-                spent["reset"] += time.perf_counter() - began
-                spent["kernel"], spent["step"] = inside  # a reset's own still step counts in the reset
-                resets += 1
+            if worlds:
+                env.step(actions[steps // count % len(actions)])
+            else:
+                _, _, terminated, truncated, _ = env.step(actions[steps % len(actions), 0])
+                if terminated or truncated:
+                    env.reset()
+            steps += count
         elapsed = time.perf_counter() - start
     finally:
-        fused_kernels.whole_step, Simulation.step = whole_step, step
+        fused_kernels.whole_step, Simulation.step, NavigationTask.reset = whole_step, step, reset
     per_step = {key: value / steps * 1e6 for key, value in spent.items()}
-    return {"bench": "breakdown", "env": "NavigateEnv", "scenario": "obstacles_8", "steps": steps, "resets": resets,
-            "env_steps_per_s": round(steps / elapsed, 1), "us_per_step": round(elapsed / steps * 1e6, 1),
-            "kernel_us": round(per_step["kernel"], 1), "step_glue_us": round(per_step["step"] - per_step["kernel"], 1),
+    return {"bench": "breakdown", "env": type(env).__name__, "worlds": count, "scenario": "obstacles_8",
+            "steps": steps, "resets": resets, "env_steps_per_s": round(steps / elapsed, 1),
+            "us_per_step": round(elapsed / steps * 1e6, 1), "kernel_us": round(per_step["kernel"], 1),
+            "step_glue_us": round(per_step["step"] - per_step["kernel"], 1),
             "env_us": round(elapsed / steps * 1e6 - per_step["step"] - per_step["reset"], 1),
             "reset_us": round(per_step["reset"], 1), "ms_per_reset": round(spent["reset"] / max(resets, 1) * 1e3, 2)}
 
@@ -187,6 +205,7 @@ def main() -> None:
     print(json.dumps(breakdown(args.seconds)), flush=True)
     for worlds in args.worlds:
         print(json.dumps(vector_speed(worlds, args.seconds)), flush=True)
+        print(json.dumps(breakdown(args.seconds, worlds)), flush=True)
     for robots in (10, 100):
         print(json.dumps(parallel_speed(robots, args.seconds)), flush=True)
     for row in baseline(args.episodes) if args.episodes > 0 else []:
