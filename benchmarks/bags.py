@@ -14,7 +14,11 @@ Every run steps on the compiled kernels from its first step (``STAGE_SIM_KERNELS
   <= 15; the machine's speed drifts over minutes, a pair's two runs share its phase), ``cost_pct_pairs`` the
   lowest and highest pair; ``cpu_cost_pct``, the same from the
   CPU seconds of the processes (the simulator and its bag writer), which the load of other processes disturbs
-  less; ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports,
+  less; ``threads_plain`` and ``threads_bag``, the threads ``stage_sim run`` simulates on without and with a
+  bag (a recording leaves a core to its writer process); when they differ, each pair has a third run, plain
+  on the recording's threads, which parts the cost in two medians: ``core_cost_pct``, what giving the core
+  away costs a plain run, and ``writer_cost_pct``, what recording costs on the same threads;
+  ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports,
   loading the world, and with a bag starting its writer process), which the rates leave out.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
   LaserScans in the bag per wall second, the bag's size and how many steps were dropped.
@@ -38,19 +42,25 @@ from mcap.reader import make_reader
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
+sys.path.insert(0, str(REPO))
 
 from simulate import world_text  # noqa: E402 - the benchmark worlds of N robots, shared with simulate.py
+
+from stage_sim.runs.pacing import threads_for_run  # noqa: E402 - the threads stage_sim run chooses
 
 STAGE_SIM = Path(sys.executable).with_name("stage_sim")
 RATE = re.compile(r": ([\d.]+) s of sim time in ([\d.]+) s of wall time")
 
 
-def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict:
-    """One ``stage_sim run``: sim and wall seconds it reports, and what the bag holds."""
+def run(world: Path, duration: float, controller: str, bag: Path | None, threads: int | None = None) -> dict:
+    """One ``stage_sim run`` (on ``threads`` threads, else its own choice): sim and wall seconds it reports,
+    and what the bag holds."""
     command = [str(STAGE_SIM), "run", str(world), "--duration", str(duration), "--speedup", "0",
                "--controller", controller, "--seed", "1"]
     if bag is not None:
         command += ["--bag", str(bag)]
+    if threads is not None:
+        command += ["--threads", str(threads)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.monotonic()
     # The compiled kernels from the first step: a run of a few wall seconds would otherwise spend most of them
@@ -79,10 +89,15 @@ def run(world: Path, duration: float, controller: str, bag: Path | None) -> dict
 def overhead(world: Path, robots: int, controller: str, duration: float, repeat: int, bag: Path) -> dict:
     """Plain and recorded runs of one case, interleaved in pairs: the cost is the median of the pairs' costs
     (the runs of a pair share the machine's phase; its speed drifts by tens of percent over minutes), the
-    rates the best of each."""
-    plains, bags = [], []
+    rates the best of each. When a recording simulates on fewer threads than a plain run (it leaves a core
+    to its writer), each pair also has a plain run on those threads: what the core given away costs, and
+    what the writer costs on top of it."""
+    full, fewer = threads_for_run(None, 0.0), threads_for_run(None, 0.0, recording=True)
+    plains, bags, narrow = [], [], []
     for _ in range(repeat):
         plains.append(run(world, duration, controller, None))
+        if fewer < full:
+            narrow.append(run(world, duration, controller, None, fewer))
         bags.append(run(world, duration, controller, bag))
     plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
     cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
@@ -96,7 +111,17 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
         "cpu_cost_pct": round(100 * (cpu_bag / cpu_plain - 1), 1),
         "setup_s_plain": round(min(r["setup_s"] for r in plains), 2),
         "setup_s_bag": round(min(r["setup_s"] for r in bags), 2),
-        "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"]}
+        "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"],
+        "threads_plain": full, "threads_bag": fewer,
+        # The two parts of the cost when the recording gives a core away, medians of the same pairs.
+        **({"core_cost_pct": _median_cost(plains, narrow), "writer_cost_pct": _median_cost(narrow, bags)}
+           if narrow else {})}
+
+
+def _median_cost(before: list[dict], after: list[dict]) -> float:
+    """How much slower each run of ``after`` is than its pair in ``before`` (%), the median."""
+    return round(statistics.median(100 * (1 - b["sim_rate"] / a["sim_rate"])
+                                   for a, b in zip(before, after, strict=True)), 1)
 
 
 def main() -> None:
