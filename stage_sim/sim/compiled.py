@@ -208,7 +208,7 @@ class FusedStep:
         odometry, final, stalled_out = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=bool)
         layers = layers.copy()
         published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
-        cells, cell_robot, marked, tiles, active = fused_kernels.whole_step(
+        marked, tiles, active = fused_kernels.whole_step(
             self._world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast,
             robots.marked, robots.active, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
             intensity)
@@ -218,18 +218,24 @@ class FusedStep:
         if tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
             robots.reserve(tiles)
             self._pack()
-            marked, _, active = fused_kernels.sense(self._world, final, final_trig, cells, cell_robot, robots.marked,
-                                                    robots.active, published, intensity)
+            marked, _, active = fused_kernels.sense_again(self._world, layers, layer, final, final_trig, robots.marked,
+                                                          robots.active, published, intensity)
             robots.took(marked, active)
         return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
 
     def warm(self, poses: np.ndarray) -> None:
-        """Load its kernels (compiling what numba's cache lacks): a step from ``poses`` and a cast into a grown
-        robot layer, whose results are dropped (what it remembers is checked at every step)."""
+        """Load its kernels (compiling what numba's cache lacks): a step from ``poses``, a cast into a grown
+        robot layer, then a cast through no robot cell, which leaves the layer empty; the results are dropped
+        (what it remembers is checked at every step)."""
         n = len(poses)
-        self.step(poses, np.stack([poses, poses]), 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
+        layers = np.stack([poses, poses])
+        self.step(poses, layers, 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
                   np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
         robots, final_trig = self._robots, self._scratch[2]
+        marked, _, active = fused_kernels.sense_again(self._world, layers, 0, poses, final_trig, robots.marked,
+                                                      robots.active, np.empty(self._beams, dtype=np.float32),
+                                                      np.empty(self._beams, dtype=np.float32))
+        robots.took(marked, active)
         marked, _, active = fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64),
                                                 np.zeros(0, dtype=np.int64), robots.marked, robots.active,
                                                 np.empty(self._beams, dtype=np.float32),

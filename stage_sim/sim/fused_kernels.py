@@ -181,8 +181,9 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
     robot order). Writes the new poses, stall flags and their cos and sin into ``final``, ``stalled_out`` and
     ``final_trig``, the layer's new poses into ``layers[layer]``, the true pose as odometry of the robots
     without ``uses_odom``, and what ``world.known`` and ``world.known_trig`` hold for the next step
-    (:func:`advance`). Returns the raster the rays saw and :func:`sense`'s answer (without a cast: the moves'
-    raster and the layer's state as given)."""
+    (:func:`advance`). Returns :func:`sense`'s answer (without a cast: the layer's state as given). Not the
+    raster the rays saw: each array a call returns costs its caller some 0.7 µs to receive, and only the rare
+    cast into a grown layer needs it again (:func:`sense_again` makes it anew)."""
     n = poses.shape[0]
     known, known_trig, collides = world.known, world.known_trig, world.collides  # locals: each read of a field
     layer_poses = layers[layer].copy()  # counts a reference
@@ -242,14 +243,25 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
             known_trig[1, 0, i], known_trig[1, 1, i] = final_trig[0, i], final_trig[1, i]
         known[1, i] = odometry[i, 2]
     if not cast:
-        return end_cells, end_robot, old_marked, 0, active
+        return old_marked, 0, active
     if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
         cells, cell_robot = end_cells, end_robot
     else:
         cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
-    marked, tiles, active = sense(world, final, final_trig, cells, cell_robot, old_marked, active, published,
-                                  intensity)
-    return cells, cell_robot, marked, tiles, active
+    return sense(world, final, final_trig, cells, cell_robot, old_marked, active, published, intensity)
+
+
+@numba.njit(**_JIT)
+def sense_again(world, layers, layer, poses, trig, old_marked, active, published, intensity):
+    """:func:`sense` again after :func:`step` found the robot layer too small (the caller grew it): through the
+    raster of every robot where layer ``layer`` of ``layers`` now holds them, which is the raster :func:`step`
+    cast through (the same cells in the same order: when every robot moved as tested, its end raster is this
+    one)."""
+    row = 2 + layer
+    known_trig = world.known_trig
+    cells, cell_robot = _raster(world, np.arange(poses.shape[0]), layers[layer], known_trig[row, 0],
+                                known_trig[row, 1])
+    return sense(world, poses, trig, cells, cell_robot, old_marked, active, published, intensity)
 
 
 @numba.njit(**_JIT)

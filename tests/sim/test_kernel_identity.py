@@ -103,3 +103,42 @@ def test_a_thousand_robot_crowd_is_identical_under_both_kernels():
     world = load_world_text(WORLD.replace("samples 271", "samples 9") + "\n".join(rows) + "\n", "thousand.world")
     numba_run = run(world, "numba", 2, 2, 9)
     assert numba_run == run(world, "numpy", 1, 2, 9)
+
+
+SPREAD = """
+resolution 0.05
+interval_sim 100
+define wall model ( color "black" )
+wall( size [16 0.1 1] pose [8 0 0 0] )
+wall( size [16 0.1 1] pose [8 16 0 0] )
+wall( size [0.1 16 1] pose [0 8 0 0] )
+wall( size [0.1 16 1] pose [16 8 0 0] )
+define laser ranger ( sensor( range [0 5] fov 240 samples 61 ) size [0.05 0.05 0.05] )
+define bot position ( size [0.4 0.3 0.2] localization "odom" laser( pose [0.1 0 -0.1 0] ) )
+"""
+
+
+def test_a_fused_step_that_grows_the_robot_layer_casts_as_the_reference(monkeypatch):
+    """Robots leaving a huddle for every side come to need more of the robot layer's tiles than it held: the
+    fused step grows it and casts again through the step's raster (``fused_kernels.sense_again``), as the
+    reference casts."""
+    from stage_sim.sim import fused_kernels
+
+    rows = [f"bot( pose [{8 + np.cos(a):.3f} {8 + np.sin(a):.3f} 0 {np.degrees(a):.1f}] )"
+            for a in np.linspace(0, 2 * np.pi, 10, endpoint=False)]
+    world = load_world_text(SPREAD + "\n".join(rows) + "\n", "spread.world")
+    regrown = []
+    sense_again = fused_kernels.sense_again
+    monkeypatch.setattr(fused_kernels, "sense_again", lambda *args: regrown.append(1) or sense_again(*args))
+    frames = {}
+    for kernels in ("numba", "numpy"):
+        sim = Simulation(world, seed=4, kernels=kernels, threads=1)
+        for i in range(len(sim.robots)):
+            sim.set_velocity(i, 0.8, 0.0, 0.1)
+        frames[kernels] = []
+        for _ in range(80):
+            sim.step()
+            ranges = np.concatenate([s.ranges for robot in sim.scans for s in robot])
+            frames[kernels].append((sim.true_poses.tobytes(), sim.stalled.tobytes(), ranges.tobytes()))
+    assert regrown
+    assert frames["numba"] == frames["numpy"]
