@@ -30,6 +30,10 @@ BATCH = 64
 QUICK_BATCHES = 4
 #: Side (cells) of the blocks in which :func:`_clusters` looks for new bodies.
 CLUSTER_BLOCK = 32
+#: Windows around an episode's obstacles tried before the whole grid is labelled, each this many times wider
+#: than the last (:meth:`FreeSpace._index_near`).
+WINDOW_TRIES = 3
+WINDOW_GROWTH = 3
 
 
 class PlacementError(ValueError):
@@ -79,12 +83,14 @@ class FreeSpace:
         added = blocked & ~self._blocked
         valid = self._valid.copy()
         pad = self._pad
+        added_cells = np.flatnonzero(added)
+        clusters = _clusters(added, added_cells)
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import clear_near
 
-            clear_near(valid, added, np.flatnonzero(added), self._near_offsets(pad))
+            clear_near(valid, added, added_cells, self._near_offsets(pad))
         else:
-            for rows, cols in _clusters(added):
+            for rows, cols in clusters:
                 window = (slice(max(rows.start - pad, 0), rows.stop + pad),
                           slice(max(cols.start - pad, 0), cols.stop + pad))
                 clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
@@ -92,7 +98,7 @@ class FreeSpace:
         space = copy.copy(self)
         space._bodies = list(static.bodies)
         space._blocked = blocked
-        space._index(valid, sim.kernels == "numba")
+        space._index_near(self, valid, clusters, pad + 1, sim.kernels == "numba")
         return space
 
     def _near_offsets(self, pad: int) -> np.ndarray:
@@ -131,23 +137,68 @@ class FreeSpace:
         """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
         compiled twin of scipy's labelling (:mod:`stage_sim.envs.free_space_kernels`, the same labels)."""
         self._valid = valid
-        if compiled:
-            from stage_sim.envs.free_space_kernels import label8
-
-            self.regions, count = label8(valid)
+        regions, self._count = _label(valid, compiled)
+        self._regions: np.ndarray | None = regions
+        cells = np.flatnonzero(valid)
+        self._cells: np.ndarray | _CellIndex = cells
+        if self._count == 1:  # the common case needs no sorting by region
+            self._region_cells: list[np.ndarray | _CellIndex] = [cells]
         else:
-            self.regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
-        self.cells = np.flatnonzero(valid)
-        if count == 1:  # the common case needs no sorting by region
-            self._region_cells = [self.cells]
-        else:
-            labels = self.regions.ravel()[self.cells]
+            labels = regions.ravel()[cells]
             order = np.argsort(labels, kind="stable")
-            ends = np.searchsorted(labels[order], np.arange(1, count + 2))
-            self._region_cells = [self.cells[order[a:b]] for a, b in itertools.pairwise(ends)]
+            ends = np.searchsorted(labels[order], np.arange(1, self._count + 2))
+            self._region_cells = [cells[order[a:b]] for a, b in itertools.pairwise(ends)]
         """The valid cells of region r at index r - 1, in increasing order."""
-        if self.cells.size == 0:
+        self._check_room()
+
+    def _index_near(self, base: FreeSpace, valid: np.ndarray, boxes: list[tuple[slice, slice]], reach: int,
+                    compiled: bool) -> None:
+        """:meth:`_index` of ``valid``, which is ``base``'s valid centres less some within ``reach`` - 1 cells of
+        ``boxes``, without labelling the whole grid when it can. Around the boxes, windows wider than that
+        (disjoint: overlapping ones merged): if ``base`` is one region and the valid centres of every window
+        are one region within it, so is ``valid`` (a path between two centres that crossed a lost cell enters
+        its window at a centre and leaves it at one of its outer cells, never lost; the two are joined inside
+        the window), and its cells are ``base``'s less those lost, looked up in ``base``'s without a copy
+        (:class:`_CellIndex`). A window split in two may join around its obstacle a little farther out: the
+        windows are tried :data:`WINDOW_TRIES` times, wider each time; then the whole grid is labelled."""
+        windows = None
+        if base._count == 1:
+            for widen in range(WINDOW_TRIES):
+                tried = _windows(boxes, reach * WINDOW_GROWTH**widen, valid.shape)
+                if all(_label(valid[window], compiled)[1] <= 1 for window in tried):
+                    windows = tried
+                    break
+        if windows is None:
+            self._index(valid, compiled)
+            return
+        lost = [np.flatnonzero(base._valid[window] & ~valid[window]) for window in windows]
+        flat = [(rows.start + local // (cols.stop - cols.start)) * self.width + cols.start
+                + local % (cols.stop - cols.start) for (rows, cols), local in zip(windows, lost, strict=True)]
+        removed = np.sort(np.concatenate([np.zeros(0, dtype=np.int64), *flat]))
+        base_cells = base.cells
+        self._valid = valid
+        self._count = 1
+        self._regions = None
+        self._cells = _CellIndex(base_cells, np.searchsorted(base_cells, removed))
+        self._region_cells = [self._cells]
+        self._check_room()
+
+    def _check_room(self) -> None:
+        if len(self._cells) == 0:
             raise PlacementError(f"no free space wide enough for a robot of radius {self.radius:.2f} m")
+
+    @property
+    def cells(self) -> np.ndarray:
+        """The valid centres' flat cells, in increasing order."""
+        return np.asarray(self._cells)
+
+    @property
+    def regions(self) -> np.ndarray:
+        """(H, W) int32 region label of every cell (0: not a valid centre), numbered as scipy's 8-connected
+        labelling numbers them."""
+        if self._regions is None:  # one region: its label is 1
+            self._regions = self._valid.astype(np.int32)
+        return self._regions
 
     def centres(self, cells: np.ndarray) -> np.ndarray:
         """World (x, y) of the centres of flat cell indices."""
@@ -157,9 +208,10 @@ class FreeSpace:
     def region_of(self, points: np.ndarray) -> np.ndarray:
         """Region label at world points (0: not a valid centre)."""
         cols, rows = np.floor((np.asarray(points) - self.origin) / self.resolution).astype(np.int64).T
-        inside = (rows >= 0) & (rows < self.regions.shape[0]) & (cols >= 0) & (cols < self.width)
-        labels = np.zeros(len(rows), dtype=self.regions.dtype)
-        labels[inside] = self.regions[rows[inside], cols[inside]]
+        inside = (rows >= 0) & (rows < self._valid.shape[0]) & (cols >= 0) & (cols < self.width)
+        labels = np.zeros(len(rows), dtype=np.int32)
+        grid = self._valid if self._regions is None else self._regions  # one region: valid is its label
+        labels[inside] = grid[rows[inside], cols[inside]]
         return labels
 
     def draw(
@@ -170,13 +222,13 @@ class FreeSpace:
         but ``excluded``) and at least ``min_distance`` from ``away_from``; PlacementError if none exists."""
         pool = self._pool(region, excluded)
         fits = _Fits(avoid, separation, away_from, min_distance)
-        if pool.size:
+        if len(pool):
             for _ in range(QUICK_BATCHES):
-                points = self.centres(pool[rng.integers(len(pool), size=BATCH)])
+                points = self.centres(pool.take(rng.integers(len(pool), size=BATCH)))
                 ok = fits(points)
                 if ok.any():
                     return points[np.argmax(ok)]
-            every = self.centres(pool)
+            every = self.centres(np.asarray(pool))
             ok = np.flatnonzero(fits(every))
             if ok.size:
                 return every[ok[rng.integers(ok.size)]]
@@ -208,13 +260,13 @@ class FreeSpace:
             goals[i] = goal
         return starts, goals
 
-    def _pool(self, region: int, excluded: frozenset[int]) -> np.ndarray:
+    def _pool(self, region: int, excluded: frozenset[int]) -> np.ndarray | _CellIndex:
         """The valid cells of ``region`` (0: of every region but ``excluded``)."""
         if region:
             return self._region_cells[region - 1]
         if excluded:
             return np.concatenate([c for r, c in enumerate(self._region_cells, 1) if r not in excluded] or [[]])
-        return self.cells
+        return self._cells
 
 
 def _mark_filled(blocked: np.ndarray, body: StaticBody) -> None:
@@ -223,12 +275,65 @@ def _mark_filled(blocked: np.ndarray, body: StaticBody) -> None:
     blocked.ravel()[body.cells] = True
 
 
-def _clusters(mask: np.ndarray) -> list[tuple[slice, slice]]:
-    """Boxes (rows, cols) that hold every set cell of ``mask`` between them, one per 8-connected group of the
-    :data:`CLUSTER_BLOCK`-cell blocks holding one, each cut to its cells: the places an episode's obstacles
-    changed, found without labelling the whole grid (how cells are grouped changes no answer of
-    :meth:`FreeSpace.with_world`, only the size of its windows)."""
-    rows, cols = np.divmod(np.flatnonzero(mask), mask.shape[1])  # np.nonzero of a 2-D grid is ten times slower
+def _label(valid: np.ndarray, compiled: bool) -> tuple[np.ndarray, int]:
+    """The 8-connected regions of ``valid`` and their count: scipy's labelling or (``compiled``) its twin."""
+    if compiled:
+        from stage_sim.envs.free_space_kernels import label8
+
+        return label8(valid)
+    regions, count = ndimage.label(valid, structure=np.ones((3, 3), dtype=bool))
+    return regions, int(count)
+
+
+def _windows(boxes: list[tuple[slice, slice]], margin: int, shape: tuple[int, ...]) -> list[tuple[slice, slice]]:
+    """``boxes`` widened by ``margin`` cells on every side (cut to the grid), overlapping ones merged into their
+    bounding box until none overlap."""
+    spans = [[max(r.start - margin, 0), min(r.stop + margin, shape[0]), max(c.start - margin, 0),
+              min(c.stop + margin, shape[1])] for r, c in boxes]
+    merged = True
+    while merged:
+        merged = False
+        for i, j in itertools.combinations(range(len(spans)), 2):
+            a, b = spans[i], spans[j]
+            if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]:
+                spans[i] = [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])]
+                del spans[j]
+                merged = True
+                break
+    return [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in spans]
+
+
+class _CellIndex:
+    """Sorted flat cells: ``base``'s (sorted) less those at the sorted positions ``removed``, looked up without
+    copying the rest (an episode's obstacles take a few thousand of some 340,000 valid centres, and a copy of
+    them cost more than the labelling it saves). :meth:`take` answers as the array's ``take``."""
+
+    def __init__(self, base: np.ndarray, removed: np.ndarray) -> None:
+        self._base = base
+        self._removed = removed
+        self._shift = removed - np.arange(removed.size)
+        """Position k of the rest is position k + (how many of these are <= k) of ``base``."""
+        self._array: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return self._base.size - self._removed.size
+
+    def take(self, positions: np.ndarray) -> np.ndarray:
+        return self._base[positions + np.searchsorted(self._shift, positions, side="right")]
+
+    def __array__(self, dtype: np.dtype | None = None, copy: bool | None = None) -> np.ndarray:
+        if self._array is None:
+            self._array = np.delete(self._base, self._removed)
+        return np.array(self._array, dtype=dtype, copy=copy)
+
+
+def _clusters(mask: np.ndarray, cells: np.ndarray | None = None) -> list[tuple[slice, slice]]:
+    """Boxes (rows, cols) that hold every set cell of ``mask`` (its flat ``cells``, when known) between them, one
+    per 8-connected group of the :data:`CLUSTER_BLOCK`-cell blocks holding one, each cut to its cells: the
+    places an episode's obstacles changed, found without labelling the whole grid (how cells are grouped
+    changes no answer of :meth:`FreeSpace.with_world`, only the size of its windows)."""
+    cells = np.flatnonzero(mask) if cells is None else cells  # np.nonzero of a 2-D grid is ten times slower
+    rows, cols = np.divmod(cells, mask.shape[1])
     if rows.size == 0:
         return []
     shape = (rows.max() // CLUSTER_BLOCK + 1, cols.max() // CLUSTER_BLOCK + 1)

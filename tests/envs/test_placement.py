@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stage_sim.envs import RobotBody
-from stage_sim.envs.free_space import FreeSpace, PlacementError
+from stage_sim.envs.free_space import FreeSpace, PlacementError, _CellIndex
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
 from stage_sim.envs.worlds import arena_text, obstacle_models
@@ -98,6 +98,37 @@ def test_the_free_space_of_an_episode_is_the_base_one_redone_only_near_its_obsta
             np.testing.assert_array_equal(mine, theirs)
     # a world that lost a body of the base is worked out anew
     assert np.array_equal(fresh.with_world(base).cells, root.cells)
+
+
+def test_a_large_arena_is_indexed_near_its_obstacles_only_and_as_a_fresh_free_space() -> None:
+    # In a 30 m arena the obstacles split the free space of no window around them (but rarely): the episode's
+    # valid cells are then the base's less those the obstacles took (no labelling, no copy of the cells), and
+    # every answer is a fresh FreeSpace's, draws included.
+    scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=8, arena_size=30.0, body=SMALL))
+    base = Simulation(scenario.base, kernels="numba")
+    root = FreeSpace(base, [0], 0.1)
+    near = 0
+    for seed in range(40):
+        sim = Simulation(scenario.world(np.random.default_rng(seed), base), kernels="numba")
+        derived, fresh = root.with_world(sim), FreeSpace(sim, [0], 0.1)
+        near += derived._regions is None
+        np.testing.assert_array_equal(derived.regions, fresh.regions)
+        np.testing.assert_array_equal(derived.cells, fresh.cells)
+        starts = [space.starts_and_goals(np.random.default_rng(seed), 1, np.zeros((0, 2)), 2.0)
+                  for space in (derived, fresh)]
+        np.testing.assert_array_equal(starts[0][0], starts[1][0])
+        np.testing.assert_array_equal(starts[0][1], starts[1][1])
+    assert near >= 30
+
+
+def test_cells_less_some_are_looked_up_as_the_array_without_them() -> None:
+    base = np.sort(np.random.default_rng(0).choice(10_000, 3_000, replace=False))
+    removed = np.sort(np.random.default_rng(1).choice(base.size, 400, replace=False))
+    index, rest = _CellIndex(base, removed), np.delete(base, removed)
+    positions = np.random.default_rng(2).integers(rest.size, size=5_000)
+    assert len(index) == rest.size
+    np.testing.assert_array_equal(index.take(positions), rest.take(positions))
+    np.testing.assert_array_equal(np.asarray(index), rest)
 
 
 def test_the_env_resets_on_every_seed_that_failed_before() -> None:
