@@ -63,7 +63,7 @@ class FreeSpace:
             from stage_sim.envs.free_space_kernels import clear_near
 
             valid = np.ones(padded.shape, dtype=bool)
-            clear_near(valid, padded, np.flatnonzero(padded), self._near_offsets(self._pad))
+            clear_near(valid, padded, np.flatnonzero(padded), self._near_spans(self._pad))
             valid = np.ascontiguousarray(valid[1:-1, 1:-1])
         else:
             valid = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution > self._reach
@@ -88,7 +88,7 @@ class FreeSpace:
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import clear_near
 
-            clear_near(valid, added, added_cells, self._near_offsets(pad))
+            clear_near(valid, added, added_cells, self._near_spans(pad))
         else:
             for rows, cols in clusters:
                 window = (slice(max(rows.start - pad, 0), rows.stop + pad),
@@ -101,13 +101,17 @@ class FreeSpace:
         space._index_near(self, valid, clusters, pad + 1, sim.kernels == "numba")
         return space
 
-    def _near_offsets(self, pad: int) -> np.ndarray:
-        """(K, 2) offsets (rows, cols) of the cells no farther than the reach from a cell, by the distance a
-        distance transform computes (``sqrt(dy² + dx²)`` cells times the resolution); ``pad`` bounds them."""
+    def _near_spans(self, pad: int) -> np.ndarray:
+        """The cells no farther than the reach from a cell, by the distance a distance transform computes
+        (``sqrt(dy² + dx²)`` cells times the resolution), row by row: (R, 3) row offset, first and last column
+        offset (the distance grows with the column offset, so each row's cells are one run); ``pad`` bounds
+        them."""
         rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
         distance = np.sqrt((rows * rows + cols * cols).astype(np.float64)) * self.resolution
         near = ~(distance > self._reach)
-        return np.ascontiguousarray(np.column_stack([rows[near], cols[near]]).astype(np.int64))
+        held = near.any(axis=1)
+        last = np.where(near, cols, -pad - 1).max(axis=1)
+        return np.ascontiguousarray(np.column_stack([rows[held, 0], -last[held], last[held]]).astype(np.int64))
 
     def _blocked_of(self, sim: Simulation) -> np.ndarray:
         """Cells no part of a robot may cover: the filled bodies of every height band of the robots."""

@@ -98,15 +98,17 @@ def label_into(valid, labels):
     return count
 
 
-def clear_near(valid: np.ndarray, added: np.ndarray, cells: np.ndarray, offsets: np.ndarray) -> None:
-    """Clear in ``valid`` (H, W) the flat ``cells`` of ``added`` (H, W) and every cell at one of ``offsets``
-    (K, 2: rows, cols) from one of them. Only the cells with a neighbour not added draw their disk: the cell of
-    ``added`` nearest to any other cell is one of those (a step from an inner cell towards it comes nearer)."""
-    clear_near_into(valid, added, cells, offsets)
+def clear_near(valid: np.ndarray, added: np.ndarray, cells: np.ndarray, spans: np.ndarray) -> None:
+    """Clear in ``valid`` (H, W) the flat ``cells`` of ``added`` (H, W) and every cell of a disk around one of
+    them, given by its rows: ``spans`` (R, 3) holds (row offset, first and last column offset) of each (a disk's
+    row is one run of cells, cleared in one inner loop). Only the cells with a neighbour not added draw their
+    disk: the cell of ``added`` nearest to any other cell is one of those (a step from an inner cell towards it
+    comes nearer)."""
+    clear_near_into(valid, added, cells, spans)
 
 
 @numba.njit(**_JIT)
-def clear_near_into(valid, added, cells, offsets):
+def clear_near_into(valid, added, cells, spans):
     """:func:`clear_near`."""
     height, width = valid.shape
     for cell in cells:
@@ -119,10 +121,11 @@ def clear_near_into(valid, added, cells, offsets):
                     inner = inner and added[r + dr, c + dc]
         if inner:
             continue
-        for k in range(offsets.shape[0]):
-            rr, cc = r + offsets[k, 0], c + offsets[k, 1]
-            if 0 <= rr < height and 0 <= cc < width:
-                valid[rr, cc] = False
+        for k in range(spans.shape[0]):
+            rr = r + spans[k, 0]
+            if 0 <= rr < height:
+                for cc in range(max(c + spans[k, 1], 0), min(c + spans[k, 2], width - 1) + 1):
+                    valid[rr, cc] = False
 
 
 def mark_filled(blocked: np.ndarray, body: StaticBody) -> None:

@@ -44,7 +44,8 @@ def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float
     pad = int(reach / resolution) + 1
     rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
     near = ~(np.sqrt((rows * rows + cols * cols).astype(np.float64)) * resolution > reach)
-    offsets = np.column_stack([rows[near], cols[near]]).astype(np.int64)
+    spans = np.array([(r, cols[i][near[i]].min(), cols[i][near[i]].max()) for i, r in enumerate(rows[:, 0])
+                      if near[i].any()], dtype=np.int64)
     for _ in range(30):
         added = np.zeros(tuple(rng.integers(5, 70, 2)), dtype=bool)
         for _ in range(rng.integers(1, 4)):  # solid blocks (deep inner cells), some at the grid's edge
@@ -53,7 +54,7 @@ def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float
         added |= rng.random(added.shape) < 0.01
         valid = rng.random(added.shape) < 0.9
         expected = valid & (ndimage.distance_transform_edt(~added) * resolution > reach)
-        clear_near(valid, added, np.flatnonzero(added), offsets)
+        clear_near(valid, added, np.flatnonzero(added), spans)
         np.testing.assert_array_equal(valid, expected)
 
 
