@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+from functools import cached_property
 
 import numpy as np
 from scipy import ndimage
@@ -63,7 +64,7 @@ class FreeSpace:
             from stage_sim.envs.free_space_kernels import clear_near
 
             valid = np.ones(padded.shape, dtype=bool)
-            clear_near(valid, padded, np.flatnonzero(padded), self._near_spans(self._pad))
+            clear_near(valid, padded, np.flatnonzero(padded), self._spans)
             valid = np.ascontiguousarray(valid[1:-1, 1:-1])
         else:
             valid = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution > self._reach
@@ -77,18 +78,19 @@ class FreeSpace:
         static = sim.static
         same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
-        blocked = self._blocked_with(sim) if same_grid else None
+        blocked, clusters = self._blocked_with(sim) if same_grid else (None, None)
         if blocked is None or (self._blocked & ~blocked).any():
             return FreeSpace(sim, self._robots, self._margin)
         added = blocked & ~self._blocked
         valid = self._valid.copy()
         pad = self._pad
         added_cells = np.flatnonzero(added)
-        clusters = _clusters(added, added_cells)
+        if clusters is None:
+            clusters = _clusters(added, added_cells)
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import clear_near
 
-            clear_near(valid, added, added_cells, self._near_spans(pad))
+            clear_near(valid, added, added_cells, self._spans)
         else:
             for rows, cols in clusters:
                 window = (slice(max(rows.start - pad, 0), rows.stop + pad),
@@ -101,11 +103,13 @@ class FreeSpace:
         space._index_near(self, valid, clusters, pad + 1, sim.kernels == "numba")
         return space
 
-    def _near_spans(self, pad: int) -> np.ndarray:
+    @cached_property
+    def _spans(self) -> np.ndarray:
         """The cells no farther than the reach from a cell, by the distance a distance transform computes
         (``sqrt(dy² + dx²)`` cells times the resolution), row by row: (R, 3) row offset, first and last column
-        offset (the distance grows with the column offset, so each row's cells are one run); ``pad`` bounds
+        offset (the distance grows with the column offset, so each row's cells are one run); the pad bounds
         them."""
+        pad = self._pad
         rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
         distance = np.sqrt((rows * rows + cols * cols).astype(np.float64)) * self.resolution
         near = ~(distance > self._reach)
@@ -120,22 +124,29 @@ class FreeSpace:
             blocked |= sim.static.filled_collision_layer(*band)
         return blocked
 
-    def _blocked_with(self, sim: Simulation) -> np.ndarray:
+    def _blocked_with(self, sim: Simulation) -> tuple[np.ndarray, list[tuple[slice, slice]] | None]:
         """:meth:`_blocked_of` ``sim`` (on this grid): this world's blocked cells and those of the bodies added
         after this world's when its bodies come first, the very objects (an episode's world,
-        :meth:`~stage_sim.sim.simulation.Simulation.with_static_models`), else worked out anew."""
+        :meth:`~stage_sim.sim.simulation.Simulation.with_static_models`), else worked out anew. With the boxes
+        (rows, cols) of the added bodies that block, when it knows them (None: worked out anew)."""
         bodies = sim.static.bodies
         if len(bodies) < len(self._bodies) or any(a is not b for a, b in zip(self._bodies, bodies, strict=False)):
-            return self._blocked_of(sim)
+            return self._blocked_of(sim), None
         bands = {sim.robots[i].z_band for i in self._robots}
         blocked = self._blocked.copy()
         mark = _mark_filled
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import mark_filled as mark
+        boxes = []
         for body in bodies[len(self._bodies):]:
-            if any(body.blocks(*band) for band in bands):
+            if any(body.blocks(*band) for band in bands) and body.outline.size:
                 mark(blocked, body)
-        return blocked
+                # its filled cells lie within its outline's box (a cell wider: the fill and the outline round
+                # the same vertices each its own way)
+                rows, cols = np.divmod(body.outline, self.width)
+                boxes.append((slice(max(int(rows[0]) - 1, 0), int(rows[-1]) + 2),
+                              slice(max(int(cols.min()) - 1, 0), int(cols.max()) + 2)))
+        return blocked, boxes
 
     def _index(self, valid: np.ndarray, compiled: bool) -> None:
         """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
