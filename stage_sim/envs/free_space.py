@@ -35,6 +35,8 @@ CLUSTER_BLOCK = 32
 #: than the last (:meth:`FreeSpace._index_near`).
 WINDOW_TRIES = 3
 WINDOW_GROWTH = 3
+#: The share of the grid the windows may cover: past it the whole grid is labelled at once.
+WINDOWS_SHARE = 0.25
 
 
 class PlacementError(ValueError):
@@ -175,11 +177,15 @@ class FreeSpace:
         its window at a centre and leaves it at one of its outer cells, never lost; the two are joined inside
         the window), and its cells are ``base``'s less those lost, looked up in ``base``'s without a copy
         (:class:`_CellIndex`). A window split in two may join around its obstacle a little farther out: the
-        windows are tried :data:`WINDOW_TRIES` times, wider each time; then the whole grid is labelled."""
+        windows are tried :data:`WINDOW_TRIES` times, wider each time, while they cover at most
+        :data:`WINDOWS_SHARE` of the grid; then the whole grid is labelled."""
         windows = None
         if base._count == 1:
             for widen in range(WINDOW_TRIES):
                 tried = _windows(boxes, reach * WINDOW_GROWTH**widen, valid.shape)
+                area = sum((rows.stop - rows.start) * (cols.stop - cols.start) for rows, cols in tried)
+                if area > valid.size * WINDOWS_SHARE:  # labelling the whole grid costs little more
+                    break
                 if all(_label(valid[window], compiled)[1] <= 1 for window in tried):
                     windows = tried
                     break
