@@ -9,7 +9,6 @@ twin, on the grid's threads, from :data:`PARALLEL_ITEMS` items on.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from types import ModuleType
 
@@ -21,7 +20,7 @@ from stage_sim.sensing.fast_caster import PARALLEL_RAYS
 from stage_sim.sensing.robot_layer import MARKED, SEVERAL_ROBOTS
 from stage_sim.sim import body_kernels, fused_kernels, motion_kernels, ranger_kernels
 from stage_sim.sim.collision import CollisionChecker, Contact
-from stage_sim.sim.drives import DriveGroup
+from stage_sim.sim.drives import DriveGroups
 from stage_sim.sim.ray_groups import SingleCast
 
 #: The steering cos and sin given to drives that read none (``Drive.steered``).
@@ -84,11 +83,11 @@ class CompiledMotion:
     (:mod:`stage_sim.sim.motion_kernels`)."""
 
     @staticmethod
-    def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbases: np.ndarray, bounds: np.ndarray,
+    def body_velocities(commands: np.ndarray, drives: DriveGroups, wheelbases: np.ndarray, bounds: np.ndarray,
                         ) -> np.ndarray:
         out = np.empty_like(commands)
         cos_steer = sin_steer = _UNSTEERED
-        if any(group.drive.steered for group in drives):
+        if drives.steered:
             steer = commands[:, 2]
             cos_steer, sin_steer = np.cos(steer), np.sin(steer)
         motion_kernels.body_velocities(commands, drives, wheelbases, bounds, cos_steer, sin_steer, out)

@@ -212,9 +212,9 @@ class Simulation:
             self._stop_silent_robots()
         self.velocities = self._body_velocities()
         layer = self._updates % 2
-        fused = self._fused is not None
-        cast = fused and self._sensing.all_due(self.sim_time)
-        if cast or (fused and self._sensing.none_due(self.sim_time)):  # a fused step casts all rangers or none
+        fused, now = self._fused is not None, self.sim_time
+        cast = fused and self._sensing.all_due(now)
+        if cast or (fused and self._sensing.none_due(now)):  # a fused step casts all rangers or none
             self._step_fused(layer, dt, cast)
         else:
             self._step_by_roles(layer, dt)

@@ -19,7 +19,7 @@ Robots are stepped in one group per drive (:func:`group_by_drive`), so no compil
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 
@@ -56,8 +56,20 @@ class DriveGroup:
     rows: np.ndarray
 
 
-def group_by_drive(names: Sequence[str]) -> tuple[DriveGroup, ...]:
+class DriveGroups(tuple):
+    """The drive groups of a world's robots (a tuple of :class:`DriveGroup`), knowing once whether any of them
+    reads the steering angle: a step asks it of its commands, and asking the groups cost 0.3 µs a step."""
+
+    steered: bool
+
+    def __new__(cls, groups: Iterable[DriveGroup]) -> DriveGroups:
+        made = super().__new__(cls, groups)
+        made.steered = any(group.drive.steered for group in made)
+        return made
+
+
+def group_by_drive(names: Sequence[str]) -> DriveGroups:
     """The robots of each drive named in ``names`` (robot order), in registry order; absent drives get none."""
     names_array = np.array(names, dtype=object)
     groups = (DriveGroup(drive, np.flatnonzero(names_array == name).astype(np.int64)) for name, drive in DRIVES.items())
-    return tuple(group for group in groups if group.rows.size)
+    return DriveGroups(group for group in groups if group.rows.size)
