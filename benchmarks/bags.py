@@ -101,7 +101,7 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
         bags.append(run(world, duration, controller, bag))
     plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
     cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
-    costs = [100 * (1 - b["sim_rate"] / p["sim_rate"]) for p, b in zip(plains, bags, strict=True)]
+    costs = _pair_costs(plains, bags)
     return {
         "case": "overhead", "world": world.name, "robots": robots, "controller": controller, "duration": duration,
         "repeat": repeat, "sim_rate_plain": plain["sim_rate"], "sim_rate_bag": recorded["sim_rate"],
@@ -114,14 +114,13 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
         "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"],
         "threads_plain": full, "threads_bag": fewer,
         # The two parts of the cost when the recording gives a core away, medians of the same pairs.
-        **({"core_cost_pct": _median_cost(plains, narrow), "writer_cost_pct": _median_cost(narrow, bags)}
-           if narrow else {})}
+        **({"core_cost_pct": round(statistics.median(_pair_costs(plains, narrow)), 1),
+            "writer_cost_pct": round(statistics.median(_pair_costs(narrow, bags)), 1)} if narrow else {})}
 
 
-def _median_cost(before: list[dict], after: list[dict]) -> float:
-    """How much slower each run of ``after`` is than its pair in ``before`` (%), the median."""
-    return round(statistics.median(100 * (1 - b["sim_rate"] / a["sim_rate"])
-                                   for a, b in zip(before, after, strict=True)), 1)
+def _pair_costs(before: list[dict], after: list[dict]) -> list[float]:
+    """How much slower each run of ``after`` is than its pair in ``before`` (%)."""
+    return [100 * (1 - b["sim_rate"] / a["sim_rate"]) for a, b in zip(before, after, strict=True)]
 
 
 def main() -> None:

@@ -348,12 +348,12 @@ class _CellIndex:
         return np.array(self._array, dtype=dtype, copy=copy)
 
 
-def _clusters(mask: np.ndarray, cells: np.ndarray | None = None) -> list[tuple[slice, slice]]:
-    """Boxes (rows, cols) that hold every set cell of ``mask`` (its flat ``cells``, when known) between them, one
-    per 8-connected group of the :data:`CLUSTER_BLOCK`-cell blocks holding one, each cut to its cells: the
-    places an episode's obstacles changed, found without labelling the whole grid (how cells are grouped
-    changes no answer of :meth:`FreeSpace.with_world`, only the size of its windows)."""
-    cells = np.flatnonzero(mask) if cells is None else cells  # np.nonzero of a 2-D grid is ten times slower
+def _clusters(mask: np.ndarray, cells: np.ndarray) -> list[tuple[slice, slice]]:
+    """Boxes (rows, cols) that hold every set cell of ``mask`` (its flat ``cells``: np.nonzero of a 2-D grid is
+    ten times slower) between them, one per 8-connected group of the :data:`CLUSTER_BLOCK`-cell blocks holding
+    one, each cut to its cells: the places an episode's obstacles changed, found without labelling the whole
+    grid (how cells are grouped changes no answer of :meth:`FreeSpace.with_world`, only the size of its
+    windows)."""
     rows, cols = np.divmod(cells, mask.shape[1])
     if rows.size == 0:
         return []
