@@ -7,7 +7,8 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   0.05 m resolution, starts and goals drawn from free space. Every agent drives a fixed arc (0.5 m/s,
   0.3 rad/s); episodes that end (a collision, the 500-step limit) are reset, and resets count in the time.
   ``core_share`` is the part of that time spent inside ``Simulation.step`` (moving robots, casting every
-  laser); the rest is the environments' own work (observations, rewards, dicts, resets).
+  laser; for the vector env its ``SimulationBatch.step``); the rest is the environments' own work
+  (observations, rewards, dicts, resets).
   ``NavigateVectorEnv`` (``--worlds``, default 64 one-robot worlds) counts env steps summed over its worlds.
   For the parallel env, ``robot_steps_per_s`` counts every robot of every step (every laser is cast every
   step, also those of agents that are done and stay as obstacles) and ``agent_steps_per_s`` only the live
@@ -18,8 +19,9 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   ``step_glue_us`` the rest of ``Simulation.step`` (Python and numpy around it), ``env_us`` the env's own
   work per step (actions, goal, observation, reward, info), ``reset_us`` the resets' time per step
   (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement). The same for the vector
-  env of ``--worlds`` worlds, per world step (each world still steps its own simulation: what a step of all
-  the worlds in one compiled call could take away is the glue, and part of the env's work).
+  env of ``--worlds`` worlds, per world step: its worlds step in one compiled call
+  (:class:`~stage_sim.sim.simulation.SimulationBatch`), whose time per world is ``kernel_us``, and
+  ``step_glue_us`` is the batch's Python per world.
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -31,6 +33,7 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +42,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from stage_sim.envs import NavigateEnv, NavigateParallelEnv, NavigateVectorEnv
 from stage_sim.envs.rollouts import run_parallel, run_single, summarise
-from stage_sim.sim.simulation import Simulation
+from stage_sim.sim.simulation import Simulation, SimulationBatch
 
 ARENA = {"arena_size": 30.0, "resolution": 0.05}
 ARC = np.array([0.5, 0.3], dtype=np.float32)
@@ -69,14 +72,23 @@ def vector_speed(worlds: int, seconds: float) -> dict:
     envs = NavigateVectorEnv(worlds, scenario="random", **ARENA)
     envs.reset(seed=0)
     core = [0.0]
-    for task in envs.tasks:
-        core = time_core(task.sim, core)
+    batch_step = SimulationBatch.step  # the worlds step together, in one call of the batch
+
+    def timed_step(batch: SimulationBatch, *args: object) -> None:
+        start = time.perf_counter()
+        batch_step(batch, *args)
+        core[0] += time.perf_counter() - start
+
     actions = np.repeat(ARC[None], worlds, axis=0)
-    steps, start = 0, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        envs.step(actions)
-        steps += 1
-    elapsed = time.perf_counter() - start
+    SimulationBatch.step = timed_step
+    try:
+        steps, start = 0, time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            envs.step(actions)
+            steps += 1
+        elapsed = time.perf_counter() - start
+    finally:
+        SimulationBatch.step = batch_step
     return {"bench": "speed", "env": "NavigateVectorEnv", "robots": 1, "worlds": worlds, "steps": steps * worlds,
             "env_steps_per_s": round(steps * worlds / elapsed, 1), "core_share": round(core[0] / elapsed, 3)}
 
@@ -117,20 +129,27 @@ def breakdown(seconds: float, worlds: int = 0) -> dict:
     count = max(worlds, 1)
     actions = np.stack([rng.uniform(0.0, 1.0, (1000, count)), rng.uniform(-np.pi / 2, np.pi / 2, (1000, count))],
                        -1).astype(np.float32)
+    env.step(actions[0] if worlds else actions[0, 0])  # its kernels loaded before the clock starts
     spent = {"kernel": 0.0, "step": 0.0, "reset": 0.0}
     resets = 0
-    whole_step, step, reset = fused_kernels.whole_step, Simulation.step, NavigationTask.reset
+    # the compiled step: one world's, or every world's in one call (the vector env's SimulationBatch; its kernel
+    # calls the other, which must stay the compiled one)
+    kernels = {name: getattr(fused_kernels, name) for name in (("whole_steps",) if worlds else ("whole_step",))}
+    stepper = SimulationBatch if worlds else Simulation
+    step, reset = stepper.step, NavigationTask.reset
 
-    def timed_kernel(*args: object) -> object:
-        start = time.perf_counter()
-        try:
-            return whole_step(*args)
-        finally:
-            spent["kernel"] += time.perf_counter() - start
+    def timed(kernel: Callable[..., object]) -> Callable[..., object]:
+        def timed_kernel(*args: object) -> object:
+            start = time.perf_counter()
+            try:
+                return kernel(*args)
+            finally:
+                spent["kernel"] += time.perf_counter() - start
+        return timed_kernel
 
-    def timed_step(sim: Simulation) -> None:
+    def timed_step(*args: object) -> None:
         start = time.perf_counter()
-        step(sim)
+        step(*args)
         spent["step"] += time.perf_counter() - start
 
     def timed_reset(task: NavigationTask, generator: np.random.Generator) -> np.ndarray:
@@ -143,7 +162,9 @@ def breakdown(seconds: float, worlds: int = 0) -> dict:
         resets += 1
         return observations
 
-    fused_kernels.whole_step, Simulation.step, NavigationTask.reset = timed_kernel, timed_step, timed_reset
+    for name, kernel in kernels.items():
+        setattr(fused_kernels, name, timed(kernel))
+    stepper.step, NavigationTask.reset = timed_step, timed_reset
     try:
         steps = 0
         start = time.perf_counter()
@@ -157,7 +178,9 @@ def breakdown(seconds: float, worlds: int = 0) -> dict:
             steps += count
         elapsed = time.perf_counter() - start
     finally:
-        fused_kernels.whole_step, Simulation.step, NavigationTask.reset = whole_step, step, reset
+        for name, kernel in kernels.items():
+            setattr(fused_kernels, name, kernel)
+        stepper.step, NavigationTask.reset = step, reset
     per_step = {key: value / steps * 1e6 for key, value in spent.items()}
     return {"bench": "breakdown", "env": type(env).__name__, "worlds": count, "scenario": "obstacles_8",
             "steps": steps, "resets": resets, "env_steps_per_s": round(steps / elapsed, 1),
@@ -167,10 +190,9 @@ def breakdown(seconds: float, worlds: int = 0) -> dict:
             "reset_us": round(per_step["reset"], 1), "ms_per_reset": round(spent["reset"] / max(resets, 1) * 1e3, 2)}
 
 
-def time_core(sim: Simulation, spent: list[float] | None = None) -> list[float]:
-    """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list (``spent``,
-    when several simulations share one)."""
-    spent = [0.0] if spent is None else spent
+def time_core(sim: Simulation) -> list[float]:
+    """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list."""
+    spent = [0.0]
     step = sim.step
 
     def timed_step() -> None:

@@ -4,7 +4,8 @@
 default mode for this id) builds it. World i is what ``gymnasium.make("stage_sim/Navigate-v0", ...)`` would
 be, seeded with ``seed + i`` (or ``seed[i]``), and the vector env is identical to N such envs in a
 ``SyncVectorEnv`` step for step, but it does the task's work (commands, observations, rewards, episode ends)
-once for all worlds as arrays instead of once per world; only the simulation steps stay one per world.
+once for all worlds as arrays instead of once per world, and the worlds' simulation steps in one compiled call
+(:class:`~stage_sim.sim.simulation.SimulationBatch`).
 
 Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
 next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
@@ -28,6 +29,7 @@ from gymnasium.vector.utils import batch_space
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar
 from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, body_commands, score, step_result
+from stage_sim.sim.simulation import SimulationBatch
 
 
 class NavigateVectorEnv(gymnasium.vector.VectorEnv):
@@ -69,6 +71,8 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         self.steps = np.zeros(num_envs, dtype=np.int64)
         self._autoreset = np.zeros(num_envs, dtype=bool)
         self._interval = first.sim.interval
+        self._batch = SimulationBatch(num_envs)  # the worlds' steps in one compiled call
+        self._beams = first.sim.beams_of(robot)  # the robot's first ranger among the beams
 
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None,
@@ -143,20 +147,25 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         """Step the worlds in ``moving`` (the others stand) and score them as arrays: (W,) results, nothing
         for the worlds that stood. No reset: whoever calls it decides what an ended episode leads to."""
         commands = body_commands(self.actions.commands(actions))
-        for world in np.flatnonzero(moving):
-            sim = self.tasks[world].sim
+        worlds = np.flatnonzero(moving)
+        stepping = [self.tasks[world].sim for world in worlds]
+        for world, sim in zip(worlds, stepping, strict=True):
             sim.set_velocities(self._robot_row, commands[world:world + 1])
-            sim.step()
+        self._batch.step(stepping, worlds.tolist())
         self.steps += moving
-        sims = [task.sim for task in self.tasks]
-        robot = self.robot
-        poses = np.array([sim.true_poses[robot] for sim in sims])
+        robot, batch = self.robot, self._batch
+        if batch.whole:  # the stepped worlds' state as the batch holds it (the other worlds' rows are reset next)
+            poses, velocity, stalled = batch.poses[:, robot], batch.velocities[:, robot], batch.stalled[:, robot]
+            ranges = batch.ranges[:, self._beams]
+        else:
+            sims = [task.sim for task in self.tasks]
+            poses = np.array([sim.true_poses[robot] for sim in sims])
+            ranges = np.stack([sim.scans[robot][0].ranges for sim in sims])
+            velocity = np.array([sim.velocities[robot] for sim in sims])
+            stalled = np.array([sim.stalled[robot] for sim in sims])
         before = self.distance
         distance, bearing = goal_polar(poses, self.goals)
-        ranges = np.stack([sim.scans[robot][0].ranges for sim in sims])
-        velocity = np.array([sim.velocities[robot] for sim in sims])
         observations = self._observer.observe_arrays(ranges, velocity, distance, bearing)
-        stalled = np.array([sim.stalled[robot] for sim in sims])
         outcome = score(self.config.reward, before, distance, stalled)
         self.distance = distance
         return step_result(outcome, observations, distance, moving, self.steps >= self.config.max_steps)

@@ -16,18 +16,20 @@ _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
 @numba.njit(**_JIT)
-def number_robot_regions(regions, old, cells, ids, visible, place, width, marked_value):
-    """Clear the regions marked last time (``old``), mark the regions of the flat grid cells (−1: off the
-    grid) with ``marked_value``, and number the regions of the visible ones 0, 1, … in the order met.
+def number_robot_regions(regions, marked, marked_count, cells, ids, visible, place, width, marked_value):
+    """Clear the regions marked last time (the first ``marked_count[0]`` of ``marked``), mark the regions of the
+    flat grid cells (−1: off the grid) with ``marked_value`` and list them in ``marked`` (their count in
+    ``marked_count[0]``; room for every region, each is listed once), and number the regions of the visible
+    ones 0, 1, … in the order met. The marked regions stay in the caller's arrays: a returned array would cost
+    each step's caller some 0.7 µs to receive.
 
-    Returns (regions marked now, per cell its tile or -1, per cell its row · TILE + col in the tile, tiles)."""
+    Returns (per cell its tile or -1, per cell its row · TILE + col in the tile, tiles)."""
     col0, row0, rcol0, rrow0 = place[0], place[1], place[2], place[3]
     flat_regions = regions.ravel()
     rw = regions.shape[1]
-    for f in old:
-        flat_regions[f] = -1
+    for k in range(marked_count[0]):
+        flat_regions[marked[k]] = -1
     n = cells.size
-    marked = np.empty(n, dtype=np.int64)
     tile = np.full(n, -1, dtype=np.int32)
     local = np.zeros(n, dtype=np.int32)
     m = 0
@@ -58,7 +60,8 @@ def number_robot_regions(regions, old, cells, ids, visible, place, width, marked
                 count += 1
             tile[i] = flat_regions[region]
             local[i] = ((wy & (TILE - 1)) << TILE_BITS) + (wx & (TILE - 1))
-    return marked[:m], tile, local, count
+    marked_count[0] = m
+    return tile, local, count
 
 
 @numba.njit(**_JIT)

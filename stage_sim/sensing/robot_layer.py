@@ -140,12 +140,6 @@ class RobotLayer:
         """Tiles the layer has room for."""
         return self.ids.shape[0]
 
-    def took(self, marked: np.ndarray, active: bool) -> None:
-        """Note an update made elsewhere (a fused step's kernels): the regions it marked and whether it wrote a
-        cell (what the next update clears, what the next cast reads)."""
-        self._marked = marked
-        self.active = active
-
     def reserve(self, count: int) -> None:
         """Room for ``count`` tiles (grown by doubling, never shrunk: robots come back)."""
         if count > self.ids.shape[0]:
@@ -194,7 +188,13 @@ class CompiledRobotLayer(RobotLayer):
     cells, ids and regions as the reference's."""
 
     def __init__(self, grid: TileGrid) -> None:
+        # Whether the layer holds a cell, and the regions marked (the first ``marked_count[0]``), kept in arrays
+        # that the kernels update in place: a fused step (sim/fused_kernels.py) updates this layer with no
+        # answer to hand back.
+        self.active_flag = np.zeros(1, dtype=np.bool_)
+        self.marked_count = np.zeros(1, dtype=np.int64)
         super().__init__(grid)
+        self.marked_regions = np.empty(self.regions.size, dtype=np.int64)
         self.rows = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each row
         self.cols = np.zeros((0, TILE), dtype=np.uint32)  #: (T, 32) robot cells of each column
         self.rows_used = np.zeros(0, dtype=np.uint32)  #: (T,) rows of a tile holding a robot cell
@@ -210,13 +210,26 @@ class CompiledRobotLayer(RobotLayer):
 
         ids = np.asarray(robot_ids, dtype=np.int64).ravel()
         seen = np.ones(int(ids.max(initial=-1)) + 1, dtype=bool) if visible is None else np.asarray(visible, bool)
-        self._marked, tile, local, count = robot_kernels.number_robot_regions(
-            self.regions, self._marked, np.asarray(cells, dtype=np.int64).ravel(), ids, seen, self._place,
-            self.shape[1], MARKED)
+        tile, local, count = robot_kernels.number_robot_regions(
+            self.regions, self.marked_regions, self.marked_count, np.asarray(cells, dtype=np.int64).ravel(), ids,
+            seen, self._place, self.shape[1], MARKED)
         self.reserve(count)
         self.active = robot_kernels.write_robot_tiles(self.ids, self.rows, self.cols, self.rows_used, self.cols_used,
                                                       self.owner, tile, local, ids.astype(np.int32), count,
                                                       SEVERAL_ROBOTS)
+
+    @property
+    def marked(self) -> np.ndarray:
+        return self.marked_regions[:self.marked_count[0]]
+
+    @property
+    def active(self) -> bool:
+        """Whether the layer holds a robot cell (what the walk reads)."""
+        return bool(self.active_flag[0])
+
+    @active.setter
+    def active(self, value: bool) -> None:
+        self.active_flag[0] = value
 
     @property
     def tables(self) -> tuple[np.ndarray, ...]:
@@ -237,6 +250,6 @@ class CompiledRobotLayer(RobotLayer):
         from stage_sim.sensing import robot_kernels  # the compiled numbering, with no robot seen: marks only
 
         cells = np.asarray(cells, dtype=np.int64).ravel()
-        self._marked = robot_kernels.number_robot_regions(
-            self.regions, self._marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=bool),
-            self._place, self.shape[1], MARKED)[0]
+        robot_kernels.number_robot_regions(
+            self.regions, self.marked_regions, self.marked_count, cells, np.zeros(cells.size, dtype=np.int64),
+            np.zeros(1, dtype=bool), self._place, self.shape[1], MARKED)

@@ -107,6 +107,20 @@ def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int) -> 
     """The numpy reference steps role by role: it is what every fused step must give."""
 
 
+class FusedBatch(Protocol):
+    """Fused steps of several worlds in one call (:class:`~stage_sim.sim.compiled.FusedBatch`)."""
+
+    def fits(self, fused: Fused) -> bool:
+        """Whether ``fused`` can join the others' call."""
+        ...
+
+    def step(self, slots: np.ndarray, steps: list[Fused], poses: np.ndarray, layers: np.ndarray, parity: np.ndarray,
+             estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float, uses_odom: np.ndarray,
+             stalled: np.ndarray) -> FusedResult:
+        """Each world's step (every ray cast) on its slot's row of the stacked state: new arrays alike."""
+        ...
+
+
 class HitIntensity(Protocol):
     """Writes each ray's return intensity (:func:`~stage_sim.sim.returns.hit_intensity`)."""
 
@@ -146,19 +160,20 @@ class Backend:
     motion: Motion
     hit_intensity: HitIntensity
     fused: FusedFactory
+    fused_batch: type[FusedBatch] | None  #: None: no fused step, nothing to batch
     trace: Trace
 
 
 def _numpy() -> Backend:
     return Backend("numpy", partial(make_caster, kernels="numpy"), CollisionChecker, ReferenceMotion(), hit_intensity,
-                   no_fused_step, polygon_edges)
+                   no_fused_step, None, polygon_edges)
 
 
 def _numba() -> Backend:
     from stage_sim.sim import body_kernels, compiled  # imports numba
 
     return Backend("numba", partial(make_caster, kernels="numba"), compiled.CompiledCollisionChecker,
-                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of,
+                   compiled.CompiledMotion(), compiled.hit_intensity, compiled.FusedStep.of, compiled.FusedBatch,
                    body_kernels.polygon_outline)
 
 

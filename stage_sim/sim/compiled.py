@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from types import ModuleType
 
 import numpy as np
+from numba import typed
 
 from stage_sim.backend import set_threads
 from stage_sim.maps.tiles import CellValues
@@ -182,7 +183,8 @@ class FusedStep:
         self._ids = robots.ids
         tables = dict(zip(("regions", "ids", "rows", "cols", "rows_used", "cols_used", "tile_owner"), robots.tables,
                           strict=True))
-        fields = {**self._fields, **tables, "capacity": robots.capacity}
+        fields = {**self._fields, **tables, "capacity": robots.capacity, "marked": robots.marked_regions,
+                  "marked_count": robots.marked_count, "active": robots.active_flag}
         self._world = fused_kernels.fused_world(*(fields[name] for name in fused_kernels.FIELDS))
 
     @classmethod
@@ -200,27 +202,38 @@ class FusedStep:
              ) -> FusedResult:
         """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``; every ray cast
         when ``cast``, none else (no ranger due)."""
-        robots = self._robots
-        if robots.ids is not self._ids:
-            self._pack()
+        world = self.world()
         n, (integrated, end_trig, final_trig) = poses.shape[0], self._scratch
         odometry, final, stalled_out = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=bool)
         layers = layers.copy()
         published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
-        marked, tiles, active = fused_kernels.whole_step(
-            self._world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast,
-            robots.marked, robots.active, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
-            intensity)
+        tiles = fused_kernels.whole_step(
+            world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast, integrated,
+            end_trig, final_trig, odometry, final, stalled_out, published, intensity)
         if not cast:
             return FusedResult(final, stalled_out, odometry, layers, None)
-        robots.took(marked, active)
-        if tiles > robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
-            robots.reserve(tiles)
-            self._pack()
-            marked, _, active = fused_kernels.sense_again(self._world, layers, layer, final, final_trig, robots.marked,
-                                                          robots.active, published, intensity)
-            robots.took(marked, active)
+        if tiles > self._robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
+            self.cast_grown(tiles, layers, layer, final, final_trig, published, intensity)
         return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+
+    @property
+    def beams(self) -> int:
+        """Rays its steps cast."""
+        return self._beams
+
+    def world(self) -> fused_kernels.FusedWorld:
+        """What its kernels read besides the robots' state, with the robot layer's tables as they stand."""
+        if self._robots.ids is not self._ids:
+            self._pack()
+        return self._world
+
+    def cast_grown(self, tiles: int, layers: np.ndarray, layer: int, poses: np.ndarray, trig: np.ndarray,
+                   published: np.ndarray, intensity: np.ndarray) -> None:
+        """Grow the robot layer to ``tiles`` and cast every ray again
+        (:func:`~stage_sim.sim.fused_kernels.sense_again`), after a step found it too small."""
+        self._robots.reserve(tiles)
+        self._pack()
+        fused_kernels.sense_again(self._world, layers, layer, poses, trig, published, intensity)
 
     def warm(self, poses: np.ndarray) -> None:
         """Load its kernels (compiling what numba's cache lacks): a step from ``poses``, a cast into a grown
@@ -230,13 +243,69 @@ class FusedStep:
         layers = np.stack([poses, poses])
         self.step(poses, layers, 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
                   np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
-        robots, final_trig = self._robots, self._scratch[2]
-        marked, _, active = fused_kernels.sense_again(self._world, layers, 0, poses, final_trig, robots.marked,
-                                                      robots.active, np.empty(self._beams, dtype=np.float32),
-                                                      np.empty(self._beams, dtype=np.float32))
-        robots.took(marked, active)
-        marked, _, active = fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64),
-                                                np.zeros(0, dtype=np.int64), robots.marked, robots.active,
-                                                np.empty(self._beams, dtype=np.float32),
-                                                np.empty(self._beams, dtype=np.float32))
-        robots.took(marked, active)
+        final_trig = self._scratch[2]
+        fused_kernels.sense_again(self._world, layers, 0, poses, final_trig, np.empty(self._beams, dtype=np.float32),
+                                  np.empty(self._beams, dtype=np.float32))
+        fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                            np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32))
+
+
+class FusedBatch:
+    """The fused steps of several worlds of one shape (the worlds of a vector env) in one compiled call
+    (:func:`~stage_sim.sim.fused_kernels.whole_steps`), every ray cast: one dispatch and one check of the
+    arguments for all of them. The worlds stay in a typed list between calls, a slot per world, and a slot is
+    written again only when its world's :class:`FusedWorld` changes (a new episode's world, a grown robot
+    layer)."""
+
+    def __init__(self) -> None:
+        self._worlds: typed.List | None = None
+        self._held: list[fused_kernels.FusedWorld] = []
+        self._type: object = None  # numba's type of the worlds (numba's types are interned: one object per type)
+        self._beams = -1
+
+    def fits(self, fused: FusedStep) -> bool:
+        """Whether ``fused`` can join the others' call: the same rays and the same kinds of arrays as the first
+        that was asked."""
+        world_type = fused.world()._numba_type_
+        if self._type is None:
+            self._type, self._beams = world_type, fused.beams
+        return fused.beams == self._beams and world_type is self._type
+
+    def step(self, slots: np.ndarray, steps: list[FusedStep], poses: np.ndarray, layers: np.ndarray,
+             parity: np.ndarray, estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float,
+             uses_odom: np.ndarray, stalled: np.ndarray) -> FusedResult:
+        """``steps[k].step`` (every ray cast) of the world in slot ``slots[k]``, on row ``slots[k]`` of the state
+        (a row per slot: ``poses`` (W, N, 3), ``layers`` (W, 2, N, 3) written in place, its layer
+        ``parity[slot]``, ...): new arrays of a row per slot, the stepped slots' rows written (the others' as
+        given; their scans unset); the scans (W, beams). Every step must have passed :meth:`fits`."""
+        worlds = self._hold(slots, steps)
+        size, n = poses.shape[:2]
+        beams = self._beams
+        integrated, end_trig, final_trig = np.empty((size, n, 3)), np.empty((size, 2, 2 * n)), np.empty((size, 2, n))
+        odometry, final, stalled_out = estimates.copy(), poses.copy(), stalled.copy()  # the others' rows: as they were
+        published, intensity = np.empty((size, beams), dtype=np.float32), np.empty((size, beams), dtype=np.float32)
+        tiles = np.zeros(size, dtype=np.int64)
+        fused_kernels.whole_steps(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom,
+                                  stalled, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
+                                  intensity, tiles)
+        for k in np.flatnonzero(tiles[slots]):  # a robot layer too small: grown, its rays cast again
+            slot = slots[k]
+            steps[k].cast_grown(int(tiles[slot]), layers[slot], int(parity[slot]), final[slot], final_trig[slot],
+                                published[slot], intensity[slot])
+            self._held[slot] = worlds[slot] = steps[k].world()
+        return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+
+    def _hold(self, slots: np.ndarray, steps: list[FusedStep]) -> typed.List:
+        """The typed list with each step's world in its slot."""
+        if self._worlds is None:
+            self._worlds = typed.List.empty_list(self._type)
+        worlds, held = self._worlds, self._held
+        for slot, fused in zip(slots.tolist(), steps, strict=True):
+            world = fused.world()
+            while len(held) <= slot:
+                held.append(world)
+                worlds.append(world)
+            if held[slot] is not world:
+                held[slot] = world
+                worlds[slot] = world
+        return worlds

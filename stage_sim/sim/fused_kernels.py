@@ -35,9 +35,11 @@ FIELDS = (
     "vertices", "poly_start", "robot_poly", "radius", "grid", "ppm", "collides", "colliding", "can_clash",
     # the static cells of the one height band: slots, tiles, bits, place
     "slots", "tile_of_slot", "bits", "static_place",
-    # the rangers and the robot layer: tables (regions, ids, row and column masks, used lines, owner), its room
+    # the rangers and the robot layer: tables (regions, ids, row and column masks, used lines, owner), its room,
+    # the regions it marked and their count, whether it holds a cell (the layer's arrays, updated in place)
     "ranger_offset", "ranger_owner", "robots_seen", "visible", "regions", "ids", "rows", "cols", "rows_used",
-    "cols_used", "tile_owner", "capacity", "region_place", "width", "marked_value", "several",
+    "cols_used", "tile_owner", "capacity", "region_place", "width", "marked_value", "several", "marked",
+    "marked_count", "active",
     # the walk: the static layer's masks, tiles, slots and used lines, place, stop map and margin
     "walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used", "walk_place", "stops",
     "pad", "walk_ppm",
@@ -70,20 +72,20 @@ structref.define_proxy(FusedWorld, FusedWorldType, list(FIELDS))
 @numba.njit(**_JIT)
 def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
                 tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids, rows,
-                cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value, several,
-                walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used, walk_place, stops, pad,
-                walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin, jitter, noisy_rays,
-                noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return, several_return,
-                ranges, cell, hit_robot, headings, known, known_trig):
+                cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value, several, marked,
+                marked_count, active, walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used,
+                walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin,
+                jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return,
+                several_return, ranges, cell, hit_robot, headings, known, known_trig):
     """A :class:`FusedWorld` of the :data:`FIELDS` (compiled and cached: the proxy's own constructor is not)."""
     return FusedWorld(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
-                      tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions,
-                      ids, rows, cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value,
-                      several, walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used,
-                      walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos,
-                      last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells,
-                      static_values, robot_return, several_return, ranges, cell, hit_robot, headings, known,
-                      known_trig)
+                      tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids,
+                      rows, cols, rows_used, cols_used, tile_owner, capacity, region_place, width, marked_value,
+                      several, marked, marked_count, active, walk_rows, walk_cols, walk_tiles, walk_slots,
+                      walk_rows_used, walk_cols_used, walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner,
+                      rays, last_angle, last_cos, last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss,
+                      static_cells, static_values, robot_return, several_return, ranges, cell, hit_robot, headings,
+                      known, known_trig)
 
 
 @numba.njit(**_JIT)
@@ -148,8 +150,8 @@ def _remember(known, known_trig, row, poses):
 
 
 @numba.njit(**_JIT)
-def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast, old_marked,
-               active, integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity):
+def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast, integrated,
+               end_trig, final_trig, odometry, final, stalled_out, published, intensity):
     """A whole step: :func:`advance` from the start headings' remembered cos and sin (worked out anew when they
     are not those of ``poses``, ``estimates`` and ``layers[layer]``: the first step, a reset, a pose set between
     steps), the cos and sin of the new headings into ``end_trig`` (2, 2N), then :func:`step`, whose answer it
@@ -165,12 +167,30 @@ def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, u
     for k in range(headings.shape[0]):
         end_trig[0, k], end_trig[1, k] = math.cos(headings[k, 2]), math.sin(headings[k, 2])
     return step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
-                stalled_out, final_trig, cast, old_marked, active, published, intensity)
+                stalled_out, final_trig, cast, published, intensity)
+
+
+@numba.njit(**_JIT)
+def whole_steps(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
+                integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles):
+    """:func:`whole_step` of several worlds, every ray cast, in one call: for each slot ``s`` of ``slots``, world
+    ``worlds[s]`` (a typed list of :class:`FusedWorld`) with row ``s`` of every other argument (the worlds'
+    state, scratch and outputs stacked, world s in its layer ``parity[s]``); into ``tiles[s]`` the tiles it
+    needs when its robot layer has room for fewer (nothing cast: the caller grows the layer and casts again,
+    :func:`sense_again`), else 0. For a vector env's worlds: one call instead of a call and its argument checks
+    per world."""
+    for k in range(slots.size):
+        s = slots[k]
+        world = worlds[s]
+        needed = whole_step(world, poses[s], layers[s], parity[s], estimates[s], velocities[s], errors[s], dt,
+                            uses_odom[s], stalled[s], True, integrated[s], end_trig[s], final_trig[s], odometry[s],
+                            final[s], stalled_out[s], published[s], intensity[s])
+        tiles[s] = needed if needed > world.capacity else 0
 
 
 @numba.njit(**_JIT)
 def step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
-         stalled_out, final_trig, cast, old_marked, active, published, intensity):
+         stalled_out, final_trig, cast, published, intensity):
     """The rest of a step after :func:`advance`: Stage's moves in layer ``layer`` of ``layers`` (2, N, 3), as
     :meth:`~stage_sim.sim.collision.CollisionChecker.resolve` and the simulation's step make them, then every
     ray (:func:`sense`) from the new poses, through the robots where the layer now holds them, when ``cast``.
@@ -181,9 +201,9 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
     robot order). Writes the new poses, stall flags and their cos and sin into ``final``, ``stalled_out`` and
     ``final_trig``, the layer's new poses into ``layers[layer]``, the true pose as odometry of the robots
     without ``uses_odom``, and what ``world.known`` and ``world.known_trig`` hold for the next step
-    (:func:`advance`). Returns :func:`sense`'s answer (without a cast: the layer's state as given). Not the
-    raster the rays saw: each array a call returns costs its caller some 0.7 µs to receive, and only the rare
-    cast into a grown layer needs it again (:func:`sense_again` makes it anew)."""
+    (:func:`advance`). Returns :func:`sense`'s answer (without a cast: 0). Not the raster the rays saw: each
+    array a call returns costs its caller some 0.7 µs to receive, and only the rare cast into a grown layer
+    needs it again (:func:`sense_again` makes it anew)."""
     n = poses.shape[0]
     known, known_trig, collides = world.known, world.known_trig, world.collides  # locals: each read of a field
     layer_poses = layers[layer].copy()  # counts a reference
@@ -243,16 +263,16 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
             known_trig[1, 0, i], known_trig[1, 1, i] = final_trig[0, i], final_trig[1, i]
         known[1, i] = odometry[i, 2]
     if not cast:
-        return old_marked, 0, active
+        return 0
     if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
         cells, cell_robot = end_cells, end_robot
     else:
         cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
-    return sense(world, final, final_trig, cells, cell_robot, old_marked, active, published, intensity)
+    return sense(world, final, final_trig, cells, cell_robot, published, intensity)
 
 
 @numba.njit(**_JIT)
-def sense_again(world, layers, layer, poses, trig, old_marked, active, published, intensity):
+def sense_again(world, layers, layer, poses, trig, published, intensity):
     """:func:`sense` again after :func:`step` found the robot layer too small (the caller grew it): through the
     raster of every robot where layer ``layer`` of ``layers`` now holds them, which is the raster :func:`step`
     cast through (the same cells in the same order: when every robot moved as tested, its end raster is this
@@ -261,35 +281,36 @@ def sense_again(world, layers, layer, poses, trig, old_marked, active, published
     known_trig = world.known_trig
     cells, cell_robot = _raster(world, np.arange(poses.shape[0]), layers[layer], known_trig[row, 0],
                                 known_trig[row, 1])
-    return sense(world, poses, trig, cells, cell_robot, old_marked, active, published, intensity)
+    return sense(world, poses, trig, cells, cell_robot, published, intensity)
 
 
 @numba.njit(**_JIT)
-def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, intensity):
+def sense(world, poses, trig, cells, cell_robot, published, intensity):
     """Every ray of one height cast from ``poses`` (their cos and sin ``trig``, (2, N)) as
     :meth:`~stage_sim.sim.rangers.RangerSensing.sense` casts them when all rangers are due: the rangers'
-    origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; ``old_marked``, ``active``: the
-    layer's regions marked and whether it holds a cell), the walk (with the direction noise drawn), the
+    origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; the layer's marked regions and
+    whether it holds a cell are updated in its arrays), the walk (with the direction noise drawn), the
     intensities, the range noise drawn (r + r·p·U' + G for a hit), the float32 ranges.
 
     With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
-    layer's tiles, else their regions are only marked. Returns (regions marked, tiles needed, whether the
-    layer holds a cell); when the layer has room for fewer tiles than needed (``world.capacity``) nothing is
-    cast: the caller grows it and calls again."""
+    layer's tiles, else their regions are only marked. Returns the tiles needed; when the layer has room for
+    fewer (``world.capacity``) nothing is cast: the caller grows it and calls again."""
     w = world
     origins = np.empty((w.ranger_offset.shape[0], 2))
     motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)
+    active = w.active
     if w.robots_seen:
-        marked, tile, local, count = robot_kernels.number_robot_regions(
-            w.regions, old_marked, cells, cell_robot, w.visible, w.region_place, w.width, w.marked_value)
+        tile, local, count = robot_kernels.number_robot_regions(
+            w.regions, w.marked, w.marked_count, cells, cell_robot, w.visible, w.region_place, w.width,
+            w.marked_value)
         if count > w.capacity:
-            return marked, count, active
-        active = robot_kernels.write_robot_tiles(w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner, tile,
-                                                 local, cell_robot.astype(np.int32), count, w.several)
+            return count
+        active[0] = robot_kernels.write_robot_tiles(w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner,
+                                                    tile, local, cell_robot.astype(np.int32), count, w.several)
     else:  # a lone robot never sees itself, but its cells make Stage's regions around it non-empty
-        marked = robot_kernels.number_robot_regions(
-            w.regions, old_marked, cells, np.zeros(cells.size, dtype=np.int64), np.zeros(1, dtype=np.bool_),
-            w.region_place, w.width, w.marked_value)[0]
+        robot_kernels.number_robot_regions(
+            w.regions, w.marked, w.marked_count, cells, np.zeros(cells.size, dtype=np.int64),
+            np.zeros(1, dtype=np.bool_), w.region_place, w.width, w.marked_value)
         count = 0
     ranger_owner, ranges = w.ranger_owner, w.ranges  # locals: each read of a field counts a reference
     heading = np.empty(ranger_owner.size)
@@ -297,9 +318,9 @@ def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, 
         heading[k] = poses[ranger_owner[k], 2]
     traversal.cast_serial(
         (w.walk_rows, w.walk_cols, w.walk_tiles, w.walk_slots, w.walk_rows_used, w.walk_cols_used),
-        (w.regions, w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner), (True, active), w.walk_place,
-        w.stops, w.pad, marked, origins, w.ranger, heading, w.angle, w.jitter, (w.last_angle, w.last_cos, w.last_sin),
-        w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
+        (w.regions, w.ids, w.rows, w.cols, w.rows_used, w.cols_used, w.tile_owner), (True, active[0]),
+        w.walk_place, w.stops, w.pad, w.marked[:w.marked_count[0]], origins, w.ranger, heading, w.angle, w.jitter,
+        (w.last_angle, w.last_cos, w.last_sin), w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
     ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
                                  w.several, w.several_return, w.rays, intensity)
     noisy_rays, rmax, prop, uniform, gauss = w.noisy_rays, w.rmax, w.noise_prop, w.noise_uniform, w.noise_gauss
@@ -309,4 +330,4 @@ def sense(world, poses, trig, cells, cell_robot, old_marked, active, published, 
             ranges[i] = ranges[i] + ranges[i] * prop[k] * uniform[k] + gauss[k]
     for i in range(ranges.size):
         published[i] = np.float32(ranges[i])
-    return marked, count, active
+    return count

@@ -167,6 +167,14 @@ class RangerSensing:
         self._publish(range(len(self._rangers)) if due is None else np.flatnonzero(due), published, intensity, time)
         self.measured = MeasuredBeams(time, published, intensity, due, ray_due)
 
+    def beams_of(self, robot: int, ranger: int) -> slice:
+        """Where the beams of ranger ``ranger`` of robot ``robot`` lie among every ranger's
+        (:attr:`~stage_sim.sim.simulation.Simulation.measured_beams`)."""
+        for robot_index, ranger_index, part in self._scan_slots:
+            if (robot_index, ranger_index) == (robot, ranger):
+                return part
+        raise IndexError(f"robot {robot} has no ranger {ranger}")
+
     def all_due(self, time: float) -> bool:
         """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
         return self._stale or round(time * 1e6) >= self._all_due_us

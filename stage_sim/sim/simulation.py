@@ -18,6 +18,7 @@ Usage::
 from __future__ import annotations
 
 import copy
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,7 +26,7 @@ import numpy as np
 
 from stage_sim.backend import resolve_kernels, resolve_threads
 from stage_sim.maps.raster import StaticRaster, build_static_raster, with_models
-from stage_sim.sim.backends import Backend, backend_for
+from stage_sim.sim.backends import Backend, FusedBatch, backend_for
 from stage_sim.sim.collision import Bodies, Contact, GridFrame
 from stage_sim.sim.drives import group_by_drive
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kernels_running, upgrade_wanted
@@ -318,6 +319,11 @@ class Simulation:
         them); None before the first."""
         return self._sensing.measured
 
+    def beams_of(self, robot: int, ranger: int = 0) -> slice:
+        """Where the beams of ranger ``ranger`` of robot ``robot`` lie among every ranger's (its scans' ranges are
+        these of :attr:`measured_beams`, and of a :class:`SimulationBatch`'s ``ranges`` row)."""
+        return self._sensing.beams_of(robot, ranger)
+
     def state(self, robot: int) -> RobotState:
         """One robot's true pose, odometry, applied velocity and stall flag."""
         return RobotState(
@@ -349,3 +355,130 @@ class Simulation:
             return robot.start
         return (origin.x, origin.y, origin.yaw)
 
+
+
+@dataclass(frozen=True)
+class _BatchShape:
+    """What every simulation of a :class:`SimulationBatch`'s call shares: the interval, and robots of the same
+    drives and bounds in the same order (their body velocities are worked out in one call)."""
+
+    interval_us: int
+    drives: tuple[str, ...]
+    wheelbases: bytes
+    bounds: bytes
+
+    @classmethod
+    def of(cls, sim: Simulation) -> _BatchShape:
+        return cls(sim.interval_us, tuple(r.settings.drive for r in sim.robots), sim._wheelbases.tobytes(),
+                   sim._bounds.tobytes())
+
+
+class SimulationBatch:
+    """Simulations stepped together, each as its own :meth:`Simulation.step` would step it (the same poses,
+    flags, odometry and scans, bit for bit), the fused steps of all those that take one (compiled kernels,
+    every ranger due, the same interval and robots) in one compiled call: a vector env's worlds, whose
+    per-world calls and their Python cost more than the step's own work at one robot a world.
+
+    The worlds' state stays stacked here between steps, a row per slot, and each simulation's arrays are views
+    of its row (new arrays every step, as :meth:`Simulation.step` makes them; its commands stay one array, which
+    :meth:`Simulation.set_velocities` writes in place); a row is copied in again only when its simulation's
+    arrays are not the views it was given (a reset, a pose set, a step of its own). When every simulation of a
+    step joined the call (:attr:`whole`), :attr:`poses`, :attr:`stalled`, :attr:`velocities` and
+    :attr:`ranges` (every beam, float32) are the stepped slots' new state, a row per slot (the other rows as
+    they were before the step, their ranges unset)."""
+
+    def __init__(self, size: int) -> None:
+        """``size``: the slots, one per world."""
+        self.size = size
+        self._fused: FusedBatch | None = None  # made when a compiled world first joins
+        self._shape: _BatchShape | None = None  # of the first that joined: that of every one that joins
+        self._members: list[tuple[Simulation, object] | None] = [None] * size  # per slot: (simulation, fused step)
+        self._given: list[tuple[object, ...] | None] = [None] * size  # per slot: the arrays its simulation holds
+        self._state: tuple[np.ndarray, ...] = ()  # poses, layers, odometry, stalled, errors, uses_odom, commands
+        self._motion: tuple = ()  # the body velocities' call: motion, drives, wheelbases and bounds of all slots
+        self.poses = self.stalled = self.velocities = self.ranges = np.empty(0)
+        self.whole = False  #: whether every simulation of the last step joined the compiled call
+
+    def step(self, sims: Sequence[Simulation], slots: Sequence[int]) -> None:
+        """Step each of ``sims`` once; ``slots[k]``: the slot of ``sims[k]``, the same for a world at every step
+        (an env's world index), whatever subset steps."""
+        joined: list[Simulation] = []
+        joined_slots: list[int] = []
+        alone = False
+        for sim, slot in zip(sims, slots, strict=True):
+            member = self._members[slot]
+            if ((member is not None and member[0] is sim and member[1] is sim._fused) or self._admit(sim, slot)) \
+                    and sim._sensing.all_due((sim.sim_time_us + sim.interval_us) / MICROSECONDS):
+                joined.append(sim)
+                joined_slots.append(slot)
+            else:  # not a fused step that casts every ranger (as Simulation.step would make it), or of another shape
+                sim.step()
+                alone = True
+        if joined:
+            self._step_joined(joined, joined_slots)
+        self.whole = bool(joined) and not alone
+
+    def _step_joined(self, sims: list[Simulation], slots: list[int]) -> None:
+        """The compiled call for ``sims`` (each has joined), and what each simulation keeps of it."""
+        poses, layers, odometry, stalled, errors, uses_odom, commands = self._state
+        parity = np.zeros(self.size, dtype=np.int64)
+        given_all = self._given
+        for sim, slot in zip(sims, slots, strict=True):
+            sim.sim_time_us += sim.interval_us
+            if sim.watchdog_timeout > 0:
+                sim._stop_silent_robots()
+            sim._sensing.draw_all_noise()
+            parity[slot] = sim._updates % 2
+            given = given_all[slot]
+            if (given is None or given[0] is not sim.true_poses or given[1] is not sim.stalled
+                    or given[2] is not sim.odometry_poses or given[3] is not sim._layer_poses
+                    or given[4] is not sim.odom_errors or given[5] is not sim.commands):
+                poses[slot], stalled[slot], odometry[slot] = sim.true_poses, sim.stalled, sim.odometry_poses
+                layers[slot], errors[slot], uses_odom[slot] = sim._layer_poses, sim.odom_errors, sim._uses_odom
+                commands[slot] = sim.commands
+                sim.commands = commands[slot]  # the same commands, written in place from now on
+        motion, drives, wheelbases, bounds = self._motion
+        n = commands.shape[1]
+        velocities = motion.body_velocities(commands.reshape(-1, 3), drives, wheelbases, bounds).reshape(-1, n, 3)
+        assert self._fused is not None and self._shape is not None
+        result = self._fused.step(np.array(slots, dtype=np.int64), [sim._fused for sim in sims], poses,
+                                  layers.copy(), parity, odometry, velocities, errors,
+                                  self._shape.interval_us / MICROSECONDS, uses_odom, stalled)
+        assert result.scans is not None
+        published, intensity = result.scans
+        for sim, slot in zip(sims, slots, strict=True):
+            sim.true_poses, sim.stalled, sim.odometry_poses, sim._layer_poses = given = \
+                result.poses[slot], result.stalled[slot], result.odometry[slot], result.layers[slot]
+            given_all[slot] = (*given, sim.odom_errors, sim.commands)
+            sim.velocities = velocities[slot]
+            sim._updates += 1
+            sim._sensing.record_all(published[slot], intensity[slot], sim.sim_time)
+        self._state = (result.poses, result.layers, result.odometry, result.stalled, errors, uses_odom, commands)
+        self.poses, self.stalled, self.velocities, self.ranges = result.poses, result.stalled, velocities, published
+
+    def _admit(self, sim: Simulation, slot: int) -> bool:
+        """Whether ``sim`` (new in ``slot``, or with new kernels) takes fused steps that can share the compiled call
+        (of the shape of the first admitted); if so it becomes the slot's member."""
+        fused = sim._fused  # not None: compiled kernels running (none while a background upgrade is under way)
+        if fused is None:
+            return False
+        shape = _BatchShape.of(sim)
+        if self._fused is None:
+            batch = backend_for(sim.kernels).fused_batch
+            if batch is None:
+                return False
+            self._fused, self._shape = batch(), shape
+            self._start(sim)
+        if shape != self._shape or not self._fused.fits(fused):
+            return False
+        self._members[slot] = (sim, fused)
+        self._given[slot] = None
+        return True
+
+    def _start(self, sim: Simulation) -> None:
+        """The stacked state and the body velocities' call for robots like those of ``sim`` in every slot."""
+        w, n = self.size, len(sim.robots)
+        self._state = (np.zeros((w, n, 3)), np.zeros((w, 2, n, 3)), np.zeros((w, n, 3)), np.zeros((w, n), dtype=bool),
+                       np.zeros((w, n, 4)), np.zeros((w, n), dtype=bool), np.zeros((w, n, 3)))
+        self._motion = (backend_for(sim.kernels).motion, group_by_drive([r.settings.drive for r in sim.robots] * w),
+                        np.tile(sim._wheelbases, w), np.tile(sim._bounds, (w, 1)))

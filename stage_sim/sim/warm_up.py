@@ -9,7 +9,7 @@ import numpy as np
 
 from stage_sim.backend import numba_available
 from stage_sim.sim.backends import backend_for
-from stage_sim.sim.simulation import Simulation
+from stage_sim.sim.simulation import Simulation, SimulationBatch
 from stage_sim.worldfile.loader import load_world_text
 
 # Two touching robots with lasers in a walled box: every kernel (both ray-casting loops, robot cells,
@@ -30,9 +30,11 @@ def warm() -> None:
     from stage_sim.sim import motion_kernels  # imports numba: only once it is known to load
 
     motion_kernels.warm(2)
-    sim = Simulation(load_world_text(WORLD, "warm_up.world"), seed=0, kernels="numba")
+    world = load_world_text(WORLD, "warm_up.world")
+    sim = Simulation(world, seed=0, kernels="numba")
     sim.set_velocity(0, 0.5, 0.0, 0.5)
     sim.step()
+    SimulationBatch(2).step([sim, Simulation(world, seed=1, kernels="numba")], [0, 1])  # worlds in one call
     collision, sensing = sim.build_parts("numba")
     fused = backend_for("numba").fused(collision, sensing.single_cast(), 1)
     if fused is not None:  # its steps ran above; this also loads the cast into a grown robot layer
