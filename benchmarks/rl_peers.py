@@ -6,6 +6,9 @@ The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-bea
 
 * ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
   obstacles scenario; episodes that end are reset (resets count in the time);
+* ``stage_sim vector env`` (1-robot rows only): ``NavigateVectorEnv`` of 64 such one-robot worlds stepped
+  together (its worlds' steps in one compiled call, autoresets counted in the time), every world's robot an
+  agent: what an RL user running N copies of the one-robot env gets from stage_sim;
 * ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env), only that
   timed; the world is reset through the env (untimed) when the env would end the episode (every robot has
   collided, or the step limit), so that the core steps robots in open space as the env's do, not resting
@@ -58,10 +61,14 @@ DT = 0.1
 V_MAX, W_MAX = 1.0, math.pi / 2
 #: Case → the venv (under --venvs) whose interpreter runs it; None: this interpreter (stage_sim's venv).
 CASES: dict[str, str | None] = {
-    "stage_sim env": None, "stage_sim core": None, "stage_sim rays": None,
+    "stage_sim env": None, "stage_sim vector env": None, "stage_sim core": None, "stage_sim rays": None,
     "navground env": "navground", "navground world": "navground",
     "irsim-x": "irsim-x", "ir-sim": "ir-sim",
 }
+#: Cases of one-robot worlds only (run in the 1-robot rows).
+ONE_ROBOT_CASES = {"stage_sim vector env"}
+#: The worlds of the vector env case.
+VECTOR_WORLDS = 64
 #: The probe of ``lidar_sees_robots``: robot 1 a metre straight ahead of robot 0, nothing else around.
 PROBE = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
 #: Steps run before the clock starts (compiled kernels loaded, first scans, caches warm).
@@ -108,6 +115,7 @@ class Runner:
     """One simulator at one size: ``step`` advances every robot once, returns how many were live."""
 
     sees_robots: bool
+    agents: int  #: robots a step advances (an action row each)
 
     def step(self, action: np.ndarray) -> int:
         raise NotImplementedError
@@ -142,12 +150,17 @@ class EnvRunner(Runner):
         return live
 
 
+#: The obstacles scenario as stage_sim's envs take it.
+STAGE_OPTIONS = {"scenario": "obstacles", "n_obstacles": BOXES, "obstacle_size": BOX_SIDES, "arena_size": ARENA,
+                 "resolution": 0.05}
+
+
 class StageEnv(EnvRunner):
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.envs import NavigateEnv, NavigateParallelEnv
 
-        options = {"scenario": "obstacles", "n_obstacles": BOXES, "obstacle_size": BOX_SIDES,
-                   "arena_size": ARENA, "resolution": 0.05}
+        options = STAGE_OPTIONS
+        self.agents = robots
         self.single = robots == 1
         self.env = NavigateEnv(**options) if self.single else NavigateParallelEnv(n_robots=robots, **options)
         self.row_of = int if self.single else {name: k for k, name in enumerate(self.env.possible_agents)}.__getitem__
@@ -156,6 +169,23 @@ class StageEnv(EnvRunner):
 
     def step(self, action: np.ndarray) -> int:
         return self.step_env(action.astype(np.float32), self.row_of)
+
+
+class StageVectorEnv(Runner):
+    """``NavigateVectorEnv`` of :data:`VECTOR_WORLDS` one-robot worlds (the obstacles scenario, next-step
+    autoreset): a step advances every world, and the worlds reset by it are not live."""
+
+    def __init__(self, robots: int, seed: int) -> None:
+        from stage_sim.envs import NavigateVectorEnv
+
+        self.env = NavigateVectorEnv(VECTOR_WORLDS, **STAGE_OPTIONS)
+        self.env.reset(seed=seed)
+        self.agents = VECTOR_WORLDS
+        self.sees_robots = stage_sees_robots()
+
+    def step(self, action: np.ndarray) -> int:
+        infos = self.env.step(action.astype(np.float32))[4]
+        return int(infos["_arrived"].sum())  # the worlds that stepped (the others were reset)
 
 
 class StageCore(StageEnv):
@@ -295,6 +325,7 @@ class NavgroundWorld(Runner):
         from navground import core, sim
 
         self.core = core
+        self.agents = robots
         self.world = sim.load_world(navground_yaml(*layout(robots, seed)))
         self.states = []
         for agent in self.world.agents:
@@ -333,6 +364,8 @@ class NavgroundEnv(EnvRunner):
         import navground.learning.env  # noqa: F401  (registers "navground")
         from navground import sim
         from navground.learning import ControlActionConfig, DefaultObservationConfig
+
+        self.agents = robots
         from navground.learning.parallel_env import shared_parallel_env
 
         scenario = sim.load_scenario(navground_yaml(*layout(robots, seed), scenario=True))
@@ -371,6 +404,7 @@ class IrSim(Runner):
 
     def __init__(self, robots: int, seed: int) -> None:
         self.env = irsim_env(irsim_yaml(*layout(robots, seed)), f"rl_peers_{robots}_{seed}")
+        self.agents = robots
         self.ids = list(range(robots))
         self.sees_robots = irsim_sees_robots()
 
@@ -396,7 +430,8 @@ def irsim_sees_robots() -> bool:
 
 
 RUNNERS: dict[str, type[Runner]] = {
-    "stage_sim env": StageEnv, "stage_sim core": StageCore, "stage_sim rays": StageRays, "navground env": NavgroundEnv,
+    "stage_sim env": StageEnv, "stage_sim vector env": StageVectorEnv, "stage_sim core": StageCore,
+    "stage_sim rays": StageRays, "navground env": NavgroundEnv,
     "navground world": NavgroundWorld, "irsim-x": IrSim, "ir-sim": IrSim,
 }
 
@@ -405,7 +440,7 @@ def measure(case: str, robots: int, seconds: float, seed: int) -> dict[str, Any]
     """Steps for ``seconds`` of wall time after the warm-up (building the world is not timed), the random
     actions drawn beforehand and taken in turn."""
     runner = RUNNERS[case](robots, seed)
-    commands = actions(robots, ACTION_ROWS, seed)
+    commands = actions(runner.agents, ACTION_ROWS, seed)
     for action in commands[:WARM_UP]:
         runner.step(action)
     steps = live = 0
@@ -415,7 +450,7 @@ def measure(case: str, robots: int, seconds: float, seed: int) -> dict[str, Any]
         live += runner.step(commands[steps % ACTION_ROWS])
         steps += 1
     timed = runner.timed_seconds(elapsed)
-    return {"steps": steps, "agent_steps_per_s": robots * steps / timed, "live_agent_steps_per_s": live / timed,
+    return {"steps": steps, "agent_steps_per_s": runner.agents * steps / timed, "live_agent_steps_per_s": live / timed,
             "lidar_sees_robots": runner.sees_robots}
 
 
@@ -465,11 +500,12 @@ def main() -> int:
     cases = [case for case, python in pythons.items() if python is not None]
     core = None if args.core < 0 else args.core
     for robots in args.robots:
-        runs: dict[str, list[dict[str, Any]]] = {case: [] for case in cases}
+        runs: dict[str, list[dict[str, Any]]] = {case: [] for case in cases
+                                                  if robots == 1 or case not in ONE_ROBOT_CASES}
         for rep in range(args.reps):
-            for case in cases:
+            for case in runs:
                 runs[case].append(run_case(pythons[case], case, robots, args.seconds, rep, core))
-        for case in cases:
+        for case in runs:
             line: dict[str, Any] = {"bench": "rl_peers", "simulator": case, "robots": robots, "reps": args.reps,
                                     "steps": min(run["steps"] for run in runs[case])}
             for key in ("agent_steps_per_s", "live_agent_steps_per_s"):

@@ -23,8 +23,8 @@ TINY = {
     "jump_chain": [],
     "raycast": [],
     # The stage_sim rows only: the peers' venvs (make bench-peers) need not be there.
-    "rl_peers": ["--robots", "1", "2", "--seconds", "0.1", "--reps", "1", "--cases", "stage_sim env", "stage_sim core",
-                 "stage_sim rays"],
+    "rl_peers": ["--robots", "1", "2", "--seconds", "0.1", "--reps", "1", "--cases", "stage_sim env",
+                 "stage_sim vector env", "stage_sim core", "stage_sim rays"],
     "simulate": ["--robots", "1", "2", "--seconds", "0.5"],
     "stageros": ["--seconds", "1"],
     "startup": ["--runs", "1"],
