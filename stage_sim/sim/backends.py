@@ -160,7 +160,7 @@ class Backend:
     motion: Motion
     hit_intensity: HitIntensity
     fused: FusedFactory
-    fused_batch: type[FusedBatch] | None  #: None: no fused step, nothing to batch
+    fused_batch: Callable[[int], FusedBatch] | None  #: on so many threads; None: no fused step, nothing to batch
     trace: Trace
 
 

@@ -252,12 +252,14 @@ class FusedStep:
 
 class FusedBatch:
     """The fused steps of several worlds of one shape (the worlds of a vector env) in one compiled call
-    (:func:`~stage_sim.sim.fused_kernels.whole_steps`), every ray cast: one dispatch and one check of the
-    arguments for all of them. The worlds stay in a typed list between calls, a slot per world, and a slot is
-    written again only when its world's :class:`FusedWorld` changes (a new episode's world, a grown robot
-    layer)."""
+    (:func:`~stage_sim.sim.fused_kernels.whole_steps`, or its parallel twin on more than one thread), every ray
+    cast: one dispatch and one check of the arguments for all of them. The worlds stay in a typed list between
+    calls, a slot per world, and a slot is written again only when its world's :class:`FusedWorld` changes (a
+    new episode's world, a grown robot layer)."""
 
-    def __init__(self) -> None:
+    def __init__(self, threads: int) -> None:
+        """``threads``: the worlds are shared among that many threads (the same answers)."""
+        self._threads = threads
         self._worlds: typed.List | None = None
         self._held: list[fused_kernels.FusedWorld] = []
         self._type: object = None  # numba's type of the worlds (numba's types are interned: one object per type)
@@ -285,9 +287,12 @@ class FusedBatch:
         odometry, final, stalled_out = estimates.copy(), poses.copy(), stalled.copy()  # the others' rows: as they were
         published, intensity = np.empty((size, beams), dtype=np.float32), np.empty((size, beams), dtype=np.float32)
         tiles = np.zeros(size, dtype=np.int64)
-        fused_kernels.whole_steps(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom,
-                                  stalled, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
-                                  intensity, tiles)
+        step_all = fused_kernels.whole_steps
+        if self._threads > 1 and slots.size > 1:  # the worlds shared among the threads
+            set_threads(self._threads)
+            step_all = fused_kernels.whole_steps_parallel
+        step_all(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
+                 integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles)
         for k in np.flatnonzero(tiles[slots]):  # a robot layer too small: grown, its rays cast again
             slot = slots[k]
             steps[k].cast_grown(int(tiles[slot]), layers[slot], int(parity[slot]), final[slot], final_trig[slot],

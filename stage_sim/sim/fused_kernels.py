@@ -170,6 +170,17 @@ def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, u
                 stalled_out, final_trig, cast, published, intensity)
 
 
+@numba.njit(inline="always", **_JIT)
+def _slot_step(worlds, s, poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled, integrated,
+               end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles):
+    """:func:`whole_step` of world slot ``s`` of :func:`whole_steps`' arguments."""
+    world = worlds[s]
+    needed = whole_step(world, poses[s], layers[s], parity[s], estimates[s], velocities[s], errors[s], dt,
+                        uses_odom[s], stalled[s], True, integrated[s], end_trig[s], final_trig[s], odometry[s],
+                        final[s], stalled_out[s], published[s], intensity[s])
+    tiles[s] = needed if needed > world.capacity else 0
+
+
 @numba.njit(**_JIT)
 def whole_steps(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
                 integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles):
@@ -180,12 +191,19 @@ def whole_steps(worlds, slots, poses, layers, parity, estimates, velocities, err
     :func:`sense_again`), else 0. For a vector env's worlds: one call instead of a call and its argument checks
     per world."""
     for k in range(slots.size):
-        s = slots[k]
-        world = worlds[s]
-        needed = whole_step(world, poses[s], layers[s], parity[s], estimates[s], velocities[s], errors[s], dt,
-                            uses_odom[s], stalled[s], True, integrated[s], end_trig[s], final_trig[s], odometry[s],
-                            final[s], stalled_out[s], published[s], intensity[s])
-        tiles[s] = needed if needed > world.capacity else 0
+        _slot_step(worlds, slots[k], poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
+                   integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles)
+
+
+@numba.njit(parallel=True, **_JIT)
+def whole_steps_parallel(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom,
+                         stalled, integrated, end_trig, final_trig, odometry, final, stalled_out, published,
+                         intensity, tiles):
+    """:func:`whole_steps` with the worlds shared among threads: each world's step reads and writes only its
+    own world and rows, so the answers are the same."""
+    for k in numba.prange(slots.size):
+        _slot_step(worlds, slots[k], poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
+                   integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles)
 
 
 @numba.njit(**_JIT)

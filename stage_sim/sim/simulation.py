@@ -376,7 +376,8 @@ class _BatchShape:
 class SimulationBatch:
     """Simulations stepped together, each as its own :meth:`Simulation.step` would step it (the same poses,
     flags, odometry and scans, bit for bit), the fused steps of all those that take one (compiled kernels,
-    every ranger due, the same interval and robots) in one compiled call: a vector env's worlds, whose
+    every ranger due, the same interval and robots) in one compiled call (its worlds shared among the threads
+    of the first that joined, :attr:`Simulation.threads`, the same answers): a vector env's worlds, whose
     per-world calls and their Python cost more than the step's own work at one robot a world.
 
     The worlds' state stays stacked here between steps, a row per slot, and each simulation's arrays are views
@@ -467,7 +468,7 @@ class SimulationBatch:
             batch = backend_for(sim.kernels).fused_batch
             if batch is None:
                 return False
-            self._fused, self._shape = batch(), shape
+            self._fused, self._shape = batch(sim.threads), shape
             self._start(sim)
         if shape != self._shape or not self._fused.fits(fused):
             return False

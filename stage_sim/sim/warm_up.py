@@ -34,7 +34,9 @@ def warm() -> None:
     sim = Simulation(world, seed=0, kernels="numba")
     sim.set_velocity(0, 0.5, 0.0, 0.5)
     sim.step()
-    SimulationBatch(2).step([sim, Simulation(world, seed=1, kernels="numba")], [0, 1])  # worlds in one call
+    for threads in (1, 2):  # worlds in one call, on one thread and shared among threads
+        twins = [Simulation(world, seed=k, kernels="numba", threads=threads) for k in range(2)]
+        SimulationBatch(2).step(twins, [0, 1])
     collision, sensing = sim.build_parts("numba")
     fused = backend_for("numba").fused(collision, sensing.single_cast(), 1)
     if fused is not None:  # its steps ran above; this also loads the cast into a grown robot layer

@@ -43,13 +43,16 @@ def frame(sim: Simulation) -> tuple:
             sim.velocities.tobytes(), scans)
 
 
-def lockstep(texts: list[str], kernels: list[str], steps: int, between=None) -> tuple[list, list, list[bool]]:
+def lockstep(texts: list[str], kernels: list[str], steps: int, between=None, threads: int = 1,
+             ) -> tuple[list, list, list[bool]]:
     """The same worlds stepped one by one and through a batch under the same random commands; ``between(step,
     sims)`` changes both sets alike between steps and returns the slots to step (None: all). Returns both
-    runs' frames and, per step, whether every world stepped joined the batch's compiled call."""
+    runs' frames and, per step, whether every world stepped joined the batch's compiled call (the batched
+    simulations on ``threads`` threads)."""
     worlds = [load_world_text(text, f"w{k}.world") for k, text in enumerate(texts)]
     alone = [Simulation(w, seed=k, kernels=kinds) for k, (w, kinds) in enumerate(zip(worlds, kernels, strict=True))]
-    batched = [Simulation(w, seed=k, kernels=kinds) for k, (w, kinds) in enumerate(zip(worlds, kernels, strict=True))]
+    batched = [Simulation(w, seed=k, kernels=kinds, threads=threads)
+               for k, (w, kinds) in enumerate(zip(worlds, kernels, strict=True))]
     batch = SimulationBatch(len(texts))
     rng = np.random.default_rng(7)
     frames_alone, frames_batched, whole = [], [], []
@@ -72,15 +75,18 @@ def lockstep(texts: list[str], kernels: list[str], steps: int, between=None) -> 
     return frames_alone, frames_batched, whole
 
 
-def test_worlds_stepped_in_one_call_are_stepped_as_each_alone(monkeypatch):
+@pytest.mark.parametrize("threads", [1, 2])
+def test_worlds_stepped_in_one_call_are_stepped_as_each_alone(monkeypatch, threads):
     """Four worlds of ten robots (noise, odometry errors, robots leaving a huddle so that the robot layers grow
-    inside the batched call), each steps as it steps alone; every step joins the one compiled call."""
+    inside the batched call), each steps as it steps alone, on one thread or with the worlds shared among two;
+    every step joins the one compiled call."""
     calls, regrown = [], []
-    whole_steps, sense_again = fused_kernels.whole_steps, fused_kernels.sense_again
-    monkeypatch.setattr(fused_kernels, "whole_steps", lambda *args: calls.append(1) or whole_steps(*args))
+    name = "whole_steps" if threads == 1 else "whole_steps_parallel"
+    whole_steps, sense_again = getattr(fused_kernels, name), fused_kernels.sense_again
+    monkeypatch.setattr(fused_kernels, name, lambda *args: calls.append(1) or whole_steps(*args))
     monkeypatch.setattr(fused_kernels, "sense_again", lambda *args: regrown.append(1) or sense_again(*args))
     texts = [ring_world(10, radius) for radius in (0.8, 1.0, 1.2, 1.5)]
-    alone, batched, whole = lockstep(texts, ["numba"] * 4, 60)
+    alone, batched, whole = lockstep(texts, ["numba"] * 4, 60, threads=threads)
     assert batched == alone
     assert len(calls) == 60 and all(whole)
     assert regrown
