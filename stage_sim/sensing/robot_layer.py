@@ -14,9 +14,10 @@ let the walk cross robot-free space in one go, each caster gets what it reads be
   the tile's one robot (:data:`SEVERAL_ROBOTS` if more): a ray of that robot walks the tile as if empty of
   robots, as a robot's own cells never stop its rays (a ray leaves its robot's body through such tiles).
 
-What it costs: the region index, int32 per region (4 B per 1024 cells of the world's bounding box); per
-tile in use 4 KB of ids (int32 per cell) and 128 B of block owners and squares (numpy) or 268 B of masks
-and owner (compiled). Each update touches only the cells the robots cover (O(robot cells), no sort).
+What it costs: the region index, int32 per region (4 B per 1024 cells of the world's bounding box; the
+compiled layer also keeps room to list every region it marks, int64 per region); per tile in use 4 KB of ids
+(int32 per cell) and 128 B of block owners and squares (numpy) or 268 B of masks and owner (compiled). Each
+update touches only the cells the robots cover (O(robot cells), no sort).
 """
 
 from __future__ import annotations

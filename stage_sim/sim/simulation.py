@@ -356,7 +356,6 @@ class Simulation:
         return (origin.x, origin.y, origin.yaw)
 
 
-
 @dataclass(frozen=True)
 class _BatchShape:
     """What every simulation of a :class:`SimulationBatch`'s call shares: the interval, and robots of the same
