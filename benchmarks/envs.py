@@ -21,7 +21,8 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement). The same for the vector
   env of ``--worlds`` worlds, per world step: its worlds step in one compiled call
   (:class:`~stage_sim.sim.simulation.SimulationBatch`), whose time per world is ``kernel_us``, and
-  ``step_glue_us`` is the batch's Python per world.
+  ``step_glue_us`` is the batch's Python per world. The envs are timed in turns, ``--seconds`` each in
+  :data:`SLICES` slices, so that a slow phase of the machine weighs on both rows alike.
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -113,81 +114,109 @@ def parallel_speed(robots: int, seconds: float) -> dict:
             "core_share": round(core[0] / elapsed, 3)}
 
 
-def breakdown(seconds: float, worlds: int = 0) -> dict:
+#: Slices the breakdowns' seconds are cut into, the envs taking turns (VM phases then hit them alike).
+SLICES = 6
+
+
+class Breakdown:
     """Where an env step's time goes (see the module's docstring), on the compiled kernels: ``NavigateEnv``, or
     with ``worlds`` the vector env of that many one-robot worlds (then per world step, its autoresets timed
-    where they happen, inside its ``step``)."""
-    from stage_sim.envs.task import NavigationTask
-    from stage_sim.sim import fused_kernels
+    where they happen, inside its ``step``). :meth:`measure` adds to what earlier slices measured."""
 
-    scenario = {"scenario": "obstacles", "n_obstacles": 8, "obstacle_size": (0.3, 1.0), **ARENA}
-    env = NavigateVectorEnv(worlds, **scenario) if worlds else NavigateEnv(**scenario)
-    env.reset(seed=0)
-    for task in env.tasks if worlds else [env.task]:
-        task.sim.wait_for_kernels()
-    rng = np.random.default_rng(1)
-    count = max(worlds, 1)
-    actions = np.stack([rng.uniform(0.0, 1.0, (1000, count)), rng.uniform(-np.pi / 2, np.pi / 2, (1000, count))],
-                       -1).astype(np.float32)
-    env.step(actions[0] if worlds else actions[0, 0])  # its kernels loaded before the clock starts
-    spent = {"kernel": 0.0, "step": 0.0, "reset": 0.0}
-    resets = 0
-    # the compiled step: one world's, or every world's in one call (the vector env's SimulationBatch; its kernel
-    # calls the other, which must stay the compiled one)
-    kernels = {name: getattr(fused_kernels, name) for name in (("whole_steps",) if worlds else ("whole_step",))}
-    stepper = SimulationBatch if worlds else Simulation
-    step, reset = stepper.step, NavigationTask.reset
+    def __init__(self, worlds: int = 0) -> None:
+        scenario = {"scenario": "obstacles", "n_obstacles": 8, "obstacle_size": (0.3, 1.0), **ARENA}
+        self.worlds = worlds
+        self.env = NavigateVectorEnv(worlds, **scenario) if worlds else NavigateEnv(**scenario)
+        self.env.reset(seed=0)
+        for task in self.env.tasks if worlds else [self.env.task]:
+            task.sim.wait_for_kernels()
+        rng = np.random.default_rng(1)
+        self.count = count = max(worlds, 1)
+        self.actions = np.stack([rng.uniform(0.0, 1.0, (1000, count)),
+                                 rng.uniform(-np.pi / 2, np.pi / 2, (1000, count))], -1).astype(np.float32)
+        self.env.step(self.actions[0] if worlds else self.actions[0, 0])  # its kernels loaded before the clock
+        self.spent = {"kernel": 0.0, "step": 0.0, "reset": 0.0}
+        self.resets = self.steps = 0
+        self.elapsed = 0.0
 
-    def timed(kernel: Callable[..., object]) -> Callable[..., object]:
-        def timed_kernel(*args: object) -> object:
+    def measure(self, seconds: float) -> None:
+        """Step for ``seconds`` more, the compiled step, the rest of the simulation's step and the resets timed."""
+        from stage_sim.envs.task import NavigationTask
+        from stage_sim.sim import fused_kernels
+
+        spent, worlds, count, actions, env = self.spent, self.worlds, self.count, self.actions, self.env
+        # the compiled step: one world's, or every world's in one call (the vector env's SimulationBatch; its
+        # kernel calls the other, which must stay the compiled one)
+        kernels = {name: getattr(fused_kernels, name) for name in (("whole_steps",) if worlds else ("whole_step",))}
+        stepper = SimulationBatch if worlds else Simulation
+        step, reset = stepper.step, NavigationTask.reset
+
+        def timed(kernel: Callable[..., object]) -> Callable[..., object]:
+            def timed_kernel(*args: object) -> object:
+                start = time.perf_counter()
+                try:
+                    return kernel(*args)
+                finally:
+                    spent["kernel"] += time.perf_counter() - start
+            return timed_kernel
+
+        def timed_step(*args: object) -> None:
             start = time.perf_counter()
-            try:
-                return kernel(*args)
-            finally:
-                spent["kernel"] += time.perf_counter() - start
-        return timed_kernel
+            step(*args)
+            spent["step"] += time.perf_counter() - start
 
-    def timed_step(*args: object) -> None:
-        start = time.perf_counter()
-        step(*args)
-        spent["step"] += time.perf_counter() - start
+        def timed_reset(task: NavigationTask, generator: np.random.Generator) -> np.ndarray:
+            inside = spent["kernel"], spent["step"]
+            began = time.perf_counter()
+            observations = reset(task, generator)
+            spent["reset"] += time.perf_counter() - began
+            spent["kernel"], spent["step"] = inside  # a reset's own still step counts in the reset
+            self.resets += 1
+            return observations
 
-    def timed_reset(task: NavigationTask, generator: np.random.Generator) -> np.ndarray:
-        nonlocal resets
-        inside = spent["kernel"], spent["step"]
-        began = time.perf_counter()
-        observations = reset(task, generator)
-        spent["reset"] += time.perf_counter() - began
-        spent["kernel"], spent["step"] = inside  # a reset's own still step counts in the reset
-        resets += 1
-        return observations
-
-    for name, kernel in kernels.items():
-        setattr(fused_kernels, name, timed(kernel))
-    stepper.step, NavigationTask.reset = timed_step, timed_reset
-    try:
-        steps = 0
-        start = time.perf_counter()
-        while time.perf_counter() - start < seconds:
-            if worlds:
-                env.step(actions[steps // count % len(actions)])
-            else:
-                _, _, terminated, truncated, _ = env.step(actions[steps % len(actions), 0])
-                if terminated or truncated:
-                    env.reset()
-            steps += count
-        elapsed = time.perf_counter() - start
-    finally:
         for name, kernel in kernels.items():
-            setattr(fused_kernels, name, kernel)
-        stepper.step, NavigationTask.reset = step, reset
-    per_step = {key: value / steps * 1e6 for key, value in spent.items()}
-    return {"bench": "breakdown", "env": type(env).__name__, "worlds": count, "scenario": "obstacles_8",
-            "steps": steps, "resets": resets, "env_steps_per_s": round(steps / elapsed, 1),
-            "us_per_step": round(elapsed / steps * 1e6, 1), "kernel_us": round(per_step["kernel"], 1),
-            "step_glue_us": round(per_step["step"] - per_step["kernel"], 1),
-            "env_us": round(elapsed / steps * 1e6 - per_step["step"] - per_step["reset"], 1),
-            "reset_us": round(per_step["reset"], 1), "ms_per_reset": round(spent["reset"] / max(resets, 1) * 1e3, 2)}
+            setattr(fused_kernels, name, timed(kernel))
+        stepper.step, NavigationTask.reset = timed_step, timed_reset
+        try:
+            steps = self.steps
+            start = time.perf_counter()
+            while time.perf_counter() - start < seconds:
+                if worlds:
+                    env.step(actions[steps // count % len(actions)])
+                else:
+                    _, _, terminated, truncated, _ = env.step(actions[steps % len(actions), 0])
+                    if terminated or truncated:
+                        env.reset()
+                steps += count
+            self.elapsed += time.perf_counter() - start
+            self.steps = steps
+        finally:
+            for name, kernel in kernels.items():
+                setattr(fused_kernels, name, kernel)
+            stepper.step, NavigationTask.reset = step, reset
+
+    def row(self) -> dict:
+        """The JSON line of what was measured."""
+        steps, spent = self.steps, self.spent
+        per_step = {key: value / steps * 1e6 for key, value in spent.items()}
+        return {"bench": "breakdown", "env": type(self.env).__name__, "worlds": self.count,
+                "scenario": "obstacles_8", "steps": steps, "resets": self.resets,
+                "env_steps_per_s": round(steps / self.elapsed, 1), "us_per_step": round(self.elapsed / steps * 1e6, 1),
+                "kernel_us": round(per_step["kernel"], 1),
+                "step_glue_us": round(per_step["step"] - per_step["kernel"], 1),
+                "env_us": round(self.elapsed / steps * 1e6 - per_step["step"] - per_step["reset"], 1),
+                "reset_us": round(per_step["reset"], 1),
+                "ms_per_reset": round(spent["reset"] / max(self.resets, 1) * 1e3, 2)}
+
+
+def breakdowns(seconds: float, worlds: list[int]) -> list[dict]:
+    """:class:`Breakdown` of ``NavigateEnv`` and of the vector env of each of ``worlds``, ``seconds`` each, in
+    :data:`SLICES` slices taken in turn."""
+    runs = [Breakdown(), *(Breakdown(count) for count in worlds)]
+    for _ in range(SLICES):
+        for run in runs:
+            run.measure(seconds / SLICES)
+    return [run.row() for run in runs]
 
 
 def time_core(sim: Simulation) -> list[float]:
@@ -224,10 +253,10 @@ def main() -> None:
     parser.add_argument("--worlds", type=int, nargs="*", default=[64], help="worlds of the vector env runs")
     args = parser.parse_args()
     print(json.dumps(single_speed(args.seconds)), flush=True)
-    print(json.dumps(breakdown(args.seconds)), flush=True)
     for worlds in args.worlds:
         print(json.dumps(vector_speed(worlds, args.seconds)), flush=True)
-        print(json.dumps(breakdown(args.seconds, worlds)), flush=True)
+    for row in breakdowns(args.seconds, args.worlds):
+        print(json.dumps(row), flush=True)
     for robots in (10, 100):
         print(json.dumps(parallel_speed(robots, args.seconds)), flush=True)
     for row in baseline(args.episodes) if args.episodes > 0 else []:
