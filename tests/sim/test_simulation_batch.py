@@ -10,19 +10,12 @@ import pytest
 from stage_sim.sim import fused_kernels
 from stage_sim.sim.simulation import Simulation, SimulationBatch
 from stage_sim.worldfile.loader import load_world_text
+from tests.sim.test_kernel_identity import SPREAD
 
-ARENA = """
-resolution 0.02
-interval_sim 100
-define wall model ( color "black" )
-wall( size [16 0.1 1] pose [8 0 0 0] )
-wall( size [16 0.1 1] pose [8 16 0 0] )
-wall( size [0.1 16 1] pose [0 8 0 0] )
-wall( size [0.1 16 1] pose [16 8 0 0] )
-wall( size [1 2 1] pose [11 5 0 30] )
-define laser ranger ( sensor( range [0 5] fov 240 samples 61 noise [0.0004 0.01 0.5] ) size [0.05 0.05 0.05] )
-define bot position ( size [0.4 0.3 0.2] localization "odom" odom_error [0.05 0.05 0 0.1] laser( pose [0.1 0 -0.1 0] ) )
-"""
+# The walled 16 m arena of the identity tests, with a block, noisy lasers and odometry errors.
+ARENA = (SPREAD.replace("samples 61 )", "samples 61 noise [0.0004 0.01 0.5] )")
+         .replace('localization "odom"', 'localization "odom" odom_error [0.05 0.05 0 0.1]')
+         + "wall( size [1 2 1] pose [11 5 0 30] )\n")
 
 
 def ring_world(robots: int, radius: float, laser_interval: int | None = None) -> str:
