@@ -100,6 +100,7 @@ class FreeSpace:
                 clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
                 valid[window] &= clearance > self._reach
         space = copy.copy(self)
+        space.__dict__.pop("_rank", None)  # this space's, not the copy's
         space._bodies = list(static.bodies)
         space._blocked = blocked
         space._index_near(self, valid, clusters, pad + 1, sim.kernels == "numba")
@@ -118,6 +119,13 @@ class FreeSpace:
         held = near.any(axis=1)
         last = np.where(near, cols, -pad - 1).max(axis=1)
         return np.ascontiguousarray(np.column_stack([rows[held, 0], -last[held], last[held]]).astype(np.int64))
+
+    @cached_property
+    def _rank(self) -> np.ndarray:
+        """Per flat grid cell, the position of a valid centre among :attr:`cells` (int32; what the others hold
+        means nothing): where the cells an episode's obstacles take lie among this space's, without a search
+        through some 340,000 of them."""
+        return np.cumsum(self._valid.ravel(), dtype=np.int32) - 1
 
     def _blocked_of(self, sim: Simulation) -> np.ndarray:
         """Cells no part of a robot may cover: the filled bodies of every height band of the robots."""
@@ -196,11 +204,11 @@ class FreeSpace:
         flat = [(rows.start + local // (cols.stop - cols.start)) * self.width + cols.start
                 + local % (cols.stop - cols.start) for (rows, cols), local in zip(windows, lost, strict=True)]
         removed = np.sort(np.concatenate([np.zeros(0, dtype=np.int64), *flat]))
-        base_cells = base.cells
+        positions = base._rank[removed].astype(np.int64)
         self._valid = valid
         self._count = 1
         self._regions = None
-        self._cells = _CellIndex(base_cells, np.searchsorted(base_cells, removed))
+        self._cells = _CellIndex(base.cells, positions)
         self._region_cells = [self._cells]
         self._check_room()
 

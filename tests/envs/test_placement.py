@@ -121,6 +121,23 @@ def test_a_large_arena_is_indexed_near_its_obstacles_only_and_as_a_fresh_free_sp
     assert near >= 30
 
 
+def test_an_episode_free_space_derives_the_next_one_as_a_fresh_free_space() -> None:
+    # A free space derived from another (its world with more bodies) answers for its own cells, not its
+    # parent's: where the next obstacles' cells lie among them is its own to work out.
+    scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=4, arena_size=30.0, body=SMALL))
+    base = Simulation(scenario.base, kernels="numba")
+    root = FreeSpace(base, [0], 0.1)
+    for seed in range(6):
+        world = scenario.world(np.random.default_rng(seed), base)
+        derived = root.with_world(Simulation(world, kernels="numba"))
+        boxes = np.array([[-6.0 + 2.5 * seed, 5.0, 0.8, 0.5, 0.3], [4.0, -7.0 + 2.0 * seed, 0.6, 0.9, -1.0]])
+        more = scenario.source.add(world, obstacle_models(boxes, world.settings), False)
+        sim = Simulation(more, kernels="numba")
+        again, fresh = derived.with_world(sim), FreeSpace(sim, [0], 0.1)
+        np.testing.assert_array_equal(again.regions, fresh.regions)
+        np.testing.assert_array_equal(again.cells, fresh.cells)
+
+
 def test_cells_less_some_are_looked_up_as_the_array_without_them() -> None:
     base = np.sort(np.random.default_rng(0).choice(10_000, 3_000, replace=False))
     removed = np.sort(np.random.default_rng(1).choice(base.size, 400, replace=False))
