@@ -1,6 +1,6 @@
 """Record a running simulation into an MCAP bag without holding up its steps.
 
-After every step the stepping thread copies what the step published into a :class:`StepBatch` and goes on; a
+After every step the stepping thread keeps what the step published in a :class:`StepBatch` and goes on; a
 batch of steps at a time goes into a bounded queue, from which a sender thread pipes it to the bag's writer
 process (:mod:`stage_sim.bags.writer`), which makes and writes the messages on another core. When the queue
 is full (the writer or the disk cannot keep up):
@@ -168,6 +168,9 @@ class BagRecorder:
         batch, self._pending = self._pending, self._empty_batch()
         if self.failed:
             return
+        # Here, not in the sender thread: there it would hold the interpreter lock while the stepping thread
+        # waits for it after each compiled call (as much time lost as the copies take).
+        batch.settle()
         try:
             self._queue.put_nowait(batch)
         except queue.Full:

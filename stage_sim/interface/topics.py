@@ -57,14 +57,17 @@ class Quantity:
 
     name: str
     read: Callable[[Simulation], Any]
+    kept: str
+    """The attribute of the simulation a recording keeps of each step, by reference (the simulation never writes
+    an array it has exposed, it replaces it): ``read``'s value, or what that is made of besides the sim time."""
 
 
-SIM_TIME_US = Quantity("sim_time_us", attrgetter("sim_time_us"))
-ODOMETRY_POSES = Quantity("odometry_poses", attrgetter("odometry_poses"))
-VELOCITIES = Quantity("velocities", attrgetter("velocities"))
-TRUE_POSES = Quantity("true_poses", attrgetter("true_poses"))
-STALLED = Quantity("stalled", attrgetter("stalled"))
-SCANS = Quantity("scans", fields.latest_scans)
+SIM_TIME_US = Quantity("sim_time_us", attrgetter("sim_time_us"), "sim_time_us")
+ODOMETRY_POSES = Quantity("odometry_poses", attrgetter("odometry_poses"), "odometry_poses")
+VELOCITIES = Quantity("velocities", attrgetter("velocities"), "velocities")
+TRUE_POSES = Quantity("true_poses", attrgetter("true_poses"), "true_poses")
+STALLED = Quantity("stalled", attrgetter("stalled"), "stalled")
+SCANS = Quantity("scans", fields.latest_scans, "measured_beams")
 
 
 def _same(value: Any) -> Any:

@@ -13,6 +13,10 @@ Usage::
     for _ in range(10):
         sim.step()
     sim.true_poses[0], sim.odometry_poses[0], sim.scans[0][0].ranges
+
+The state arrays it exposes (poses, odometry, velocities, stall flags, the measured beams) are never written
+once exposed: every change replaces the array. A bag recording keeps a reference to each step's instead of a
+copy (:mod:`stage_sim.bags.step_state`).
 """
 
 from __future__ import annotations
@@ -197,6 +201,7 @@ class Simulation:
             raise IndexError(f"no robot {robot} (the world has {len(self.robots)})")
         self.true_poses = self.true_poses.copy()
         self.true_poses[robot] = (x, y, float(np.remainder(yaw + np.pi, 2 * np.pi) - np.pi))
+        self.stalled = self.stalled.copy()
         self.stalled[robot] = False
         self._layer_poses = self._layer_poses.copy()
         self._layer_poses[:, robot] = self.true_poses[robot]  # Stage's SetPose maps both layers
@@ -423,6 +428,7 @@ class SimulationBatch:
         poses, layers, odometry, stalled, errors, uses_odom, commands = self._state
         parity = np.zeros(self.size, dtype=np.int64)
         given_all = self._given
+        fresh = False  # whether the rows below are written into copies: the last step's are the simulations' arrays
         for sim, slot in zip(sims, slots, strict=True):
             sim.sim_time_us += sim.interval_us
             if sim.watchdog_timeout > 0:
@@ -433,6 +439,8 @@ class SimulationBatch:
             if (given is None or given[0] is not sim.true_poses or given[1] is not sim.stalled
                     or given[2] is not sim.odometry_poses or given[3] is not sim._layer_poses
                     or given[4] is not sim.odom_errors or given[5] is not sim.commands):
+                if not fresh:
+                    poses, odometry, stalled, fresh = poses.copy(), odometry.copy(), stalled.copy(), True
                 poses[slot], stalled[slot], odometry[slot] = sim.true_poses, sim.stalled, sim.odometry_poses
                 layers[slot], errors[slot], uses_odom[slot] = sim._layer_poses, sim.odom_errors, sim._uses_odom
                 commands[slot] = sim.commands

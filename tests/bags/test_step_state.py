@@ -101,12 +101,17 @@ position( size [0.4 0.4 0.2] pose [-3 0 0 0] )
 
 def test_topics_reading_the_same_quantity_share_one_copy_and_derived_values_are_the_simulation_s() -> None:
     """odom and /tf share the odometry poses; ground truth's velocities, zero while stalled, are derived from the
-    copied velocities and stall flags after the batch's trip (robots without rangers, no scan topic)."""
+    kept velocities and stall flags after the batch's trip (robots without rangers, no scan topic). The batch
+    keeps the steps' arrays until it is sent: moving the stalled robot between steps (which clears its stall
+    flag) leaves the steps before as they were."""
     sim = Simulation(load_world_text(AGAINST_A_WALL, "wall.world"), seed=0)
     stepped = [topics.ODOM, topics.GROUND_TRUTH, topics.TF]
     batch = StepBatch.first(sim, stepped, 12)
     expected = []
-    for _ in range(12):
+    for step in range(12):
+        if step == 8:
+            assert sim.stalled[0]
+            sim.set_pose(0, 0.0, 0.0, 0.0)
         sim.set_velocity(0, 1.0, 0.0, 0.0)  # into the wall: it stalls
         sim.set_velocity(1, -0.5, 0.0, 0.2)
         sim.step()
