@@ -95,6 +95,20 @@ class Fused(Protocol):
         """Load what its steps run (compiled kernels), with the robots at ``poses``."""
         ...
 
+    @property
+    def beams(self) -> int:
+        """Rays its steps cast (a :class:`FusedBatch` lays every world's scans out by it)."""
+        ...
+
+    def world(self) -> object:
+        """What its kernels read besides the robots' state: what a :class:`FusedBatch` holds in the world's slot."""
+        ...
+
+    def cast_grown(self, tiles: int, layers: np.ndarray, layer: int, poses: np.ndarray, trig: np.ndarray,
+                   published: np.ndarray, intensity: np.ndarray) -> None:
+        """Grow its robot layer to ``tiles`` and cast every ray again, after a batched step found it too small."""
+        ...
+
 
 class FusedFactory(Protocol):
     """The fused step of a world's contacts and rays (:meth:`~stage_sim.sim.rangers.RangerSensing.single_cast`)
