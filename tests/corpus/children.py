@@ -7,7 +7,6 @@ machine down, and never leaves pytest itself short of memory.
 
 from __future__ import annotations
 
-import os
 import queue
 import re
 import resource
@@ -21,7 +20,8 @@ from pathlib import Path
 
 MEMORY_LIMIT_BYTES = 4 * 1024**3
 WALL_TIMEOUT_S = 60.0
-"""A safety net only: the 10 s budget is checked on the child's CPU time, which a loaded machine does not inflate."""
+"""A safety net only: ``stage_sim inspect``'s 10 s budget is checked on the child's CPU time (a loaded machine
+inflates wall time more)."""
 CPU_BUDGET_S = 10.0
 LOCATED_MESSAGE = re.compile(r"^(?:\S+: )?(?P<file>[^:\s]+):(?P<line>\d+):(?P<column>\d+): \S", re.MULTILINE)
 """``[prog: ]file:line:col: message`` (stageros prefixes its name)."""
@@ -35,7 +35,7 @@ class ChildRun:
     stdout: str
     stderr: str
     cpu_seconds: float
-    """CPU seconds of the whole run, or, with ``ready``, until the child said it had come up."""
+    """CPU seconds of the whole run."""
 
 
 def _cap_memory() -> None:
@@ -45,12 +45,6 @@ def _cap_memory() -> None:
 def _children_cpu() -> float:
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     return usage.ru_utime + usage.ru_stime
-
-
-def _process_cpu(pid: int) -> float:
-    """CPU seconds a running process has used so far (all its threads)."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def python_command(*args: str) -> list[str]:
@@ -65,8 +59,7 @@ def console_script(name: str) -> str:
 
 def run_limited(command: list[str], ready: re.Pattern[str] | None = None) -> ChildRun:
     """Run ``command`` with capped memory until it exits (or the wall timeout); with ``ready``, interrupt
-    it (Ctrl-C) as soon as a line of its stderr matches, as a user stops a simulator that has come up; the CPU
-    seconds are then those it took to come up."""
+    it (Ctrl-C) as soon as a line of its stderr matches, as a user stops a simulator that has come up."""
     cpu_before = _children_cpu()
     if ready is None:
         try:
@@ -80,7 +73,7 @@ def run_limited(command: list[str], ready: re.Pattern[str] | None = None) -> Chi
     lines: queue.Queue[str | None] = queue.Queue()
     threading.Thread(target=lambda: [*map(lines.put, child.stderr), lines.put(None)], daemon=True).start()
     stderr: list[str] = []
-    up_cpu: float | None = None
+    interrupted = False
     deadline = time.monotonic() + WALL_TIMEOUT_S
     while True:
         try:
@@ -92,8 +85,8 @@ def run_limited(command: list[str], ready: re.Pattern[str] | None = None) -> Chi
         if line is None:
             break
         stderr.append(line)
-        if ready.search(line) and up_cpu is None:
-            up_cpu = _process_cpu(child.pid)
+        if ready.search(line) and not interrupted:
+            interrupted = True
             child.send_signal(signal.SIGINT)
     returncode = child.wait()
-    return ChildRun(returncode, "", "".join(stderr), _children_cpu() - cpu_before if up_cpu is None else up_cpu)
+    return ChildRun(returncode, "", "".join(stderr), _children_cpu() - cpu_before)
