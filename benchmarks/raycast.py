@@ -1,15 +1,16 @@
 """Benchmark of the ray casters (numpy reference and numba kernel) against a plain per-ray numba traversal.
 
-Run with the project's venv python: ``.venv/bin/python benchmarks/raycast.py``. Prints one JSON object per
-line, pinned to one core: ``rays_per_s`` (numpy caster), ``numba_rays_per_s`` (the simulator's compiled
-kernel, :mod:`stage_sim.sensing.traversal`), ``reference_rays_per_s`` (Stage's walk visiting every cell,
-the tests' plain port of ``World::Raytrace``) and their ratios; ``agree``: share of rays whose hit cell
-equals the reference's; ``numba_identical``: whether the numba kernel's answers equal the numpy caster's
-bit for bit.
+Run with the project's venv python: ``.venv/bin/python benchmarks/raycast.py [--poses 100] [--robots 1000]
+[--repeats 5]``. Prints one JSON object per line, pinned to one core: ``rays_per_s`` (numpy caster),
+``numba_rays_per_s`` (the simulator's compiled kernel, :mod:`stage_sim.sensing.traversal`),
+``reference_rays_per_s`` (Stage's walk visiting every cell, the tests' plain port of ``World::Raytrace``) and
+their ratios; ``agree``: share of rays whose hit cell equals the reference's; ``numba_identical``: whether the
+numba kernel's answers equal the numpy caster's bit for bit.
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import json
 import math
@@ -98,7 +99,7 @@ def scan_batch(occ: np.ndarray, poses: int, beams: int, fov_deg: float, rng) -> 
     return np.repeat(xy, beams, axis=0), angles.ravel()
 
 
-def best_of(fn, repeats: int = REPEATS) -> float:
+def best_of(fn, repeats: int) -> float:
     """Shortest wall time of ``repeats`` calls."""
     best = math.inf
     for _ in range(repeats):
@@ -122,6 +123,12 @@ def reference(occ, robot, xy, angles, rmax, owners):
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--poses", type=int, default=POSES, help="scans per map case")
+    parser.add_argument("--robots", type=int, default=1000, help="robots of the crowd case")
+    parser.add_argument("--repeats", type=int, default=REPEATS, help="timed calls of each caster (the best counts)")
+    args = parser.parse_args()
+    repeats, single_repeats = args.repeats, 10 * args.repeats
     with contextlib.suppress(AttributeError, OSError):
         os.sched_setaffinity(0, {0})  # one core, as the targets are stated
     rng = np.random.default_rng(SEED)
@@ -132,17 +139,19 @@ def main() -> None:
         fast = make_caster(occ, RESOLUTION, (0.0, 0.0), "numba")
         no_robot = np.full(occ.shape, -1, dtype=np.int32)
         for beams, fov, rmax in CASES:
-            xy, angles = scan_batch(occ, POSES, beams, fov, rng)
+            xy, angles = scan_batch(occ, args.poses, beams, fov, rng)
             owners = np.full(len(angles), -1, dtype=np.int64)
             run_ref, ref_range, ref_cell = reference(occ, no_robot, xy, angles, rmax, owners)
             run_ref()  # numba warm-up (compilation)
-            t_ref = best_of(run_ref)
+            t_ref = best_of(run_ref, repeats)
             result = caster.cast(xy, angles, rmax)
-            t_ours = best_of(lambda c=caster, xy=xy, a=angles, r=rmax: c.cast(xy, a, r))
-            single = best_of(lambda c=caster, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r), 50)
+            t_ours = best_of(lambda c=caster, xy=xy, a=angles, r=rmax: c.cast(xy, a, r), repeats)
+            single = best_of(lambda c=caster, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r),
+                             single_repeats)
             fast_result = fast.cast(xy, angles, rmax)
-            t_fast = best_of(lambda c=fast, xy=xy, a=angles, r=rmax: c.cast(xy, a, r))
-            fast_single = best_of(lambda c=fast, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r), 50)
+            t_fast = best_of(lambda c=fast, xy=xy, a=angles, r=rmax: c.cast(xy, a, r), repeats)
+            fast_single = best_of(lambda c=fast, xy=xy[:beams], a=angles[:beams], r=rmax: c.cast(xy, a, r),
+                                  single_repeats)
             emit(
                 case=f"{name}_{beams}",
                 map=label,
@@ -161,7 +170,7 @@ def main() -> None:
                 numba_identical=identical(fast_result, result),
                 numba_single_scan_ms=fast_single * 1e3,
             )
-    robots_case(occ, label, caster, fast, rng)
+    robots_case(occ, label, caster, fast, rng, args.robots, min(repeats, 3))
 
 
 def identical(a, b) -> bool:
@@ -170,7 +179,7 @@ def identical(a, b) -> bool:
                 and a.ranges.tobytes() == b.ranges.tobytes())
 
 
-def robots_case(occ, label, caster, fast, rng, robots=1000, beams=240, fov=240.0, rmax=5.6):
+def robots_case(occ, label, caster, fast, rng, robots, repeats, beams=240, fov=240.0, rmax=5.6):
     """The simulator's big step: every robot's scan, other robots' footprints in the way."""
     xy, angles = scan_batch(occ, robots, beams, fov, rng)
     centres = xy[::beams]
@@ -196,23 +205,23 @@ def robots_case(occ, label, caster, fast, rng, robots=1000, beams=240, fov=240.0
         return caster.cast(xy, angles, rmax, owners=owners, robots=layer)
 
     result = step()
-    t_step = best_of(step, 3)
-    t_raster = best_of(footprints, 3)
+    t_step = best_of(step, repeats)
+    t_raster = best_of(footprints, repeats)
     rows, cols, ids = footprints()
-    t_update = best_of(lambda: layer.update(rows, cols, ids), 3)
-    t_cast = best_of(lambda: caster.cast(xy, angles, rmax, owners=owners, robots=layer), 3)
-    t_static = best_of(lambda: caster.cast(xy, angles, rmax), 3)
+    t_update = best_of(lambda: layer.update(rows, cols, ids), repeats)
+    t_cast = best_of(lambda: caster.cast(xy, angles, rmax, owners=owners, robots=layer), repeats)
+    t_static = best_of(lambda: caster.cast(xy, angles, rmax), repeats)
     fast_layer.update(rows, cols, ids)
     fast_result = fast.cast(xy, angles, rmax, owners=owners, robots=fast_layer)
-    t_fast = best_of(lambda: fast.cast(xy, angles, rmax, owners=owners, robots=fast_layer), 3)
-    t_fast_update = best_of(lambda: fast_layer.update(rows, cols, ids), 3)
+    t_fast = best_of(lambda: fast.cast(xy, angles, rmax, owners=owners, robots=fast_layer), repeats)
+    t_fast_update = best_of(lambda: fast_layer.update(rows, cols, ids), repeats)
     grid = np.full(occ.shape, -1, dtype=np.int32)
     grid[rows, cols] = ids
     shared = grid[rows, cols] != ids  # cells of two or more robots block every ray
     grid[rows[shared], cols[shared]] = -2
     run_ref, _, ref_cell = reference(occ, grid, xy, angles, rmax, owners)
     run_ref()
-    t_ref = best_of(run_ref, 3)
+    t_ref = best_of(run_ref, repeats)
     emit(
         case=f"robots{robots}_{beams}",
         map=label,

@@ -21,7 +21,7 @@ TINY = {
     "envs": ["--seconds", "0.3", "--episodes", "0"],
     "fidelity": ["--variants", "B", "--robot-worlds", "crowd_100", "--robot-seconds", "1"],
     "jump_chain": [],
-    "raycast": [],
+    "raycast": ["--poses", "4", "--robots", "20", "--repeats", "1"],
     # The stage_sim rows only: the peers' venvs (make bench-peers) need not be there.
     "rl_peers": ["--robots", "1", "2", "--seconds", "0.1", "--reps", "1", "--cases", "stage_sim env",
                  "stage_sim vector env", "stage_sim core", "stage_sim rays"],
