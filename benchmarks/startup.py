@@ -36,7 +36,10 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import LaserScan
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
 sys.path.insert(0, str(REPO))
+
+from stageros import cpu_seconds  # noqa: E402 - a process's CPU seconds from /proc, shared with stageros.py
 
 from stage_sim.ros.domain import use_private_domain  # noqa: E402
 
@@ -56,12 +59,6 @@ class Startup:
     first_scan_s: float
 
 
-def process_cpu(pid: int) -> float:
-    """CPU seconds a running process has used so far (all its threads)."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
 def first_scan(env: dict[str, str], world: Path, topic: str, timeout: float = 120.0) -> Startup:
     """Launch stageros on ``world`` and time it until it logs that its simulation is built (it publishes the
     first scan one step later) and until this process receives its first message on ``topic``."""
@@ -79,7 +76,7 @@ def first_scan(env: dict[str, str], world: Path, topic: str, timeout: float = 12
     def watch_log() -> None:  # stageros logs "<world>: N robot(s), interval_sim ..." once its simulation is built
         for line in process.stderr:
             if "interval_sim" in line and not ready:
-                ready.append((time.monotonic(), process_cpu(process.pid)))
+                ready.append((time.monotonic(), cpu_seconds(process.pid)))
 
     threading.Thread(target=watch_log, daemon=True).start()
     try:

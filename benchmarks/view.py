@@ -37,17 +37,14 @@ from rclpy.executors import SingleThreadedExecutor
 from rosgraph_msgs.msg import Clock
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
 sys.path.insert(0, str(REPO))
 STAGEROS = Path(sys.executable).with_name("stageros")
 ROOMS = REPO / "worlds" / "rooms.world"
-TICKS = os.sysconf("SC_CLK_TCK")
+
+from stageros import cpu_seconds  # noqa: E402 - a process's CPU seconds from /proc, shared with stageros.py
 
 from tests.view.conftest import CHROMIUM, CHROMIUM_FLAGS  # noqa: E402 (after the path is set)
-
-
-def cpu_seconds(pid: int) -> float:
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICKS
 
 
 def rss_mb(pid: int) -> float:
