@@ -27,8 +27,6 @@ import numpy as np
 from stage_sim.interface import fields
 from stage_sim.interface.topics import SIM_TIME_US, Quantity, StepValues, Topic
 
-MICROSECONDS = 1_000_000
-
 if TYPE_CHECKING:
     from stage_sim.sim.rangers import MeasuredBeams
     from stage_sim.sim.simulation import Simulation
@@ -293,7 +291,7 @@ class StepBatch:
             return
         kept, start = self._kept, self.count - len(self._kept)
         by_quantity = list(zip(*kept, strict=True)) if self._several else [kept]
-        seconds = [time_us / MICROSECONDS for time_us in by_quantity[0]]  # the sim time as the simulation has it
+        seconds = [time_us / fields.MICROSECONDS for time_us in by_quantity[0]]  # the sim time as the simulation has it
         for column, values in zip(self._columns, by_quantity, strict=True):
             column.pack(values, seconds, start)
         self._kept = []

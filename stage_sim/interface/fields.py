@@ -19,10 +19,14 @@ if TYPE_CHECKING:
     from stage_sim.sim.simulation import Simulation
 
 
+MICROSECONDS = 1_000_000
+"""Microseconds a second: the simulation counts its time in integer microseconds."""
+
+
 def stamp_parts(sim_time_us: int) -> tuple[int, int]:
     """(sec, nanosec) of a sim time in integer microseconds: exact, no float rounding (also of an int64 array
     of them, element by element)."""
-    return sim_time_us // 1_000_000, (sim_time_us % 1_000_000) * 1000
+    return sim_time_us // MICROSECONDS, (sim_time_us % MICROSECONDS) * 1000
 
 
 def stamp_ns(sim_time_us: int) -> int:

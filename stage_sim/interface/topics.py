@@ -62,11 +62,16 @@ class Quantity:
     an array it has exposed, it replaces it): ``read``'s value, or what that is made of besides the sim time."""
 
 
-SIM_TIME_US = Quantity("sim_time_us", attrgetter("sim_time_us"), "sim_time_us")
-ODOMETRY_POSES = Quantity("odometry_poses", attrgetter("odometry_poses"), "odometry_poses")
-VELOCITIES = Quantity("velocities", attrgetter("velocities"), "velocities")
-TRUE_POSES = Quantity("true_poses", attrgetter("true_poses"), "true_poses")
-STALLED = Quantity("stalled", attrgetter("stalled"), "stalled")
+def _attribute(name: str) -> Quantity:
+    """The quantity that is the simulation's attribute ``name``, read and kept as it is."""
+    return Quantity(name, attrgetter(name), name)
+
+
+SIM_TIME_US = _attribute("sim_time_us")
+ODOMETRY_POSES = _attribute("odometry_poses")
+VELOCITIES = _attribute("velocities")
+TRUE_POSES = _attribute("true_poses")
+STALLED = _attribute("stalled")
 SCANS = Quantity("scans", fields.latest_scans, "measured_beams")
 
 
