@@ -37,12 +37,13 @@ def disturb(step: int, sim: Simulation) -> None:
 
 
 def assert_unchanged(kept: list[tuple[np.ndarray, bytes]]) -> None:
+    """No array kept with its bytes has changed since."""
     changed = [k for k, (array, data) in enumerate(kept) if array.tobytes() != data]
     assert not changed, f"{len(changed)} arrays exposed by earlier steps were written later"
 
 
 @pytest.mark.parametrize("kernels", ["numpy", "numba"])
-def test_a_simulation_replaces_the_arrays_it_exposed_instead_of_writing_them(kernels):
+def test_a_simulation_replaces_the_arrays_it_exposed_instead_of_writing_them(kernels: str) -> None:
     sim = Simulation(load_world_text(ring_world(6, 0.6), "ring.world"), seed=3, kernels=kernels)
     kept, stalls = [], 0
     for step in range(60):
@@ -54,7 +55,7 @@ def test_a_simulation_replaces_the_arrays_it_exposed_instead_of_writing_them(ker
     assert_unchanged(kept)
 
 
-def test_simulations_stepped_in_a_batch_replace_the_arrays_they_exposed_too():
+def test_simulations_stepped_in_a_batch_replace_the_arrays_they_exposed_too() -> None:
     """The batch copies a world's new state (after a pose set or a reset) into its stacked arrays: new ones, as
     the last step's rows are the arrays the simulations exposed."""
     sims = [Simulation(load_world_text(ring_world(6, 0.6), f"ring{k}.world"), seed=k, kernels="numba")
