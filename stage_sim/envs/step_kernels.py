@@ -1,16 +1,21 @@
-"""Compiled (numba) twin of a task step's arithmetic: the commands from the actions, then the observations,
-rewards and episode ends from the simulation's new state, each in one pass over the agents (called through
-:func:`stage_sim.envs.task.compiled_commands` and :func:`stage_sim.envs.task.compiled_finish_step`).
+"""Compiled (numba) twin of a task step's arithmetic: the commands from the actions, written into the
+simulation's command rows, then the goals' distance and bearing, the observations, rewards and episode ends
+from the simulation's new state, each in one pass over the agents (called through
+:func:`stage_sim.envs.task.compiled_command_agents` and :func:`stage_sim.envs.task.compiled_finish_step`).
 
 Why: with one robot an env step is dominated by the dozens of small numpy calls of the reference
-(:func:`stage_sim.envs.task.reference_commands` and :func:`stage_sim.envs.task.finish_step`), not by
-arithmetic. The goal's distance and bearing stay in numpy (:func:`~stage_sim.envs.spaces.goal_polar`: its
-trigonometry differs from libm's in the last bit on some CPUs); everything here is the reference's arithmetic
-operation for operation, in the same dtypes (float32 scans, float64 rewards), so both give the same arrays bit
-for bit (``tests/envs/test_step_kernels.py``). Used when the simulation runs the numba kernels.
+(:func:`stage_sim.envs.task.command_agents` and :func:`stage_sim.envs.task.finish_step`), not by
+arithmetic. Everything here is the reference's arithmetic operation for operation, in the same dtypes (float32
+scans, float64 rewards), so both give the same arrays bit for bit (``tests/envs/test_step_kernels.py``), with
+one exception: the goal's bearing comes from libm's ``atan2``, which differs from numpy's (SVML on AVX-512
+CPUs) in the last bit of some float64 values. The bearing only reaches the agent as a float32, which rounds
+that bit away (no value of 20 million random poses differed, measured), and the distance (``hypot``), from
+which the rewards come, is the same bit for bit. Used when the simulation runs the numba kernels.
 """
 
 from __future__ import annotations
+
+import math
 
 import numba
 import numpy as np
@@ -40,33 +45,48 @@ def _clip_between(value, low, high):
 
 
 @numba.njit(**_JIT)
-def continuous_commands(actions, low, high, active, out):
-    """(v, 0, ω) per agent: the actions (A, 2) clamped into [low, high] (A, 2), times 0 or 1 for ``active``."""
+def continuous_commands(actions, low, high, active, rows, out, stamps, now):
+    """(v, 0, ω) per agent a into row ``rows[a]`` of ``out``, stamped ``now`` in ``stamps``: the actions (A, 2)
+    clamped into [low, high] (A, 2), times 0 or 1 for ``active``."""
     for a in range(actions.shape[0]):
         live = 1.0 if active[a] else 0.0
-        out[a, 0] = _clip_between(actions[a, 0], low[a, 0], high[a, 0]) * live
-        out[a, 1] = 0.0
-        out[a, 2] = _clip_between(actions[a, 1], low[a, 1], high[a, 1]) * live
+        row = rows[a]
+        out[row, 0] = _clip_between(actions[a, 0], low[a, 0], high[a, 0]) * live
+        out[row, 1] = 0.0
+        out[row, 2] = _clip_between(actions[a, 1], low[a, 1], high[a, 1]) * live
+        stamps[row] = now
 
 
 @numba.njit(**_JIT)
-def discrete_commands(table, chosen, active, out):
-    """(v, 0, ω) per agent: row ``chosen[a]`` of its table (A, K, 2), times 0 or 1 for ``active``."""
+def discrete_commands(table, chosen, active, rows, out, stamps, now):
+    """(v, 0, ω) per agent a into row ``rows[a]`` of ``out``, stamped ``now`` in ``stamps``: row ``chosen[a]`` of
+    its table (A, K, 2), times 0 or 1 for ``active``."""
     for a in range(chosen.shape[0]):
         live = 1.0 if active[a] else 0.0
-        out[a, 0] = table[a, chosen[a], 0] * live
-        out[a, 1] = 0.0
-        out[a, 2] = table[a, chosen[a], 1] * live
+        row = rows[a]
+        out[row, 0] = table[a, chosen[a], 0] * live
+        out[row, 1] = 0.0
+        out[row, 2] = table[a, chosen[a], 1] * live
+        stamps[row] = now
+
+
+@numba.njit(inline="always", **_JIT)
+def _goal_polar(pose, goal):
+    """:func:`~stage_sim.envs.spaces.goal_polar` of one pose (3,) and goal (2,): distance and bearing."""
+    dx, dy = goal[0] - pose[0], goal[1] - pose[1]
+    bearing = math.atan2(dy, dx) - pose[2]
+    return math.hypot(dx, dy), math.atan2(math.sin(bearing), math.cos(bearing))
 
 
 @numba.njit(**_JIT)
-def observe_and_score(ranges, range_max, history, velocities, stalled, agents, distance, bearing, tail_low, tail_high,
-                      before, active, at_limit, weights, rows, rewards, flags):
-    """Per agent a: shift the newest scan ``ranges[a]`` / ``range_max`` (clipped to [0, 1]) into ``history``
-    (A, k, B), write its observation row into ``rows`` (the history, then distance, bearing, forward speed and
-    turn rate clipped to the tail bounds), its reward into ``rewards`` and (terminated, truncated, arrived,
-    collided) into ``flags`` (4, A); agents whose episode ends leave ``active``. ``weights``: progress,
-    arrival, collision, time, goal tolerance."""
+def observe_and_score(ranges, range_max, history, poses, velocities, stalled, agents, goals, tail_low, tail_high,
+                      before, active, at_limit, weights, rows, rewards, distance, flags):
+    """Per agent a: its goal's distance (into ``distance``) and bearing from its robot's pose, shift the newest
+    scan ``ranges[a]`` / ``range_max`` (clipped to [0, 1]) into ``history`` (A, k, B), write its observation
+    row into ``rows`` (the history, then distance, bearing, forward speed and turn rate clipped to the tail
+    bounds), its reward into ``rewards`` and (terminated, truncated, arrived, collided) into ``flags`` (4, A);
+    agents whose episode ends leave ``active``. ``weights``: progress, arrival, collision, time, goal
+    tolerance."""
     count, depth, beams = history.shape
     scans = depth * beams
     progress, arrival, collision, time, tolerance = weights[0], weights[1], weights[2], weights[3], weights[4]
@@ -79,7 +99,8 @@ def observe_and_score(ranges, range_max, history, velocities, stalled, agents, d
         for k in range(depth):
             rows[a, k * beams:(k + 1) * beams] = history[a, k, :]
         robot = agents[a]
-        tail[0], tail[1] = np.float32(distance[a]), np.float32(bearing[a])
+        distance[a], bearing = _goal_polar(poses[robot], goals[a])
+        tail[0], tail[1] = np.float32(distance[a]), np.float32(bearing)
         tail[2], tail[3] = np.float32(velocities[robot, 0]), np.float32(velocities[robot, 2])
         for t in range(4):
             rows[a, scans + t] = _clip_between(tail[t], tail_low[a, t], tail_high[a, t])

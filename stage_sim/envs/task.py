@@ -92,10 +92,11 @@ def body_commands(commands: np.ndarray) -> np.ndarray:
     return out
 
 
-def reference_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """(A, 3) body commands for one action per agent, zero for agents whose episode ended (the numpy
-    reference of :func:`compiled_commands`)."""
-    return body_commands(action_map.commands(actions) * active[:, None])
+def command_agents(sim: Simulation, agents: np.ndarray, action_map: ActionMap, actions: np.ndarray,
+                   active: np.ndarray) -> None:
+    """Command robot ``agents[a]`` of ``sim`` with agent a's action, zero for agents whose episode ended (the
+    numpy reference of :func:`compiled_command_agents`)."""
+    sim.set_velocities(agents, body_commands(action_map.commands(actions) * active[:, None]))
 
 
 def step_result(
@@ -110,12 +111,13 @@ def step_result(
 
 
 def finish_step(
-    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
-    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, goals: np.ndarray,
+    before: np.ndarray, active: np.ndarray, at_limit: bool,
 ) -> StepResult:
-    """The step's result once ``sim`` has moved: observations, rewards from the goal distances ``before`` and
-    ``distance`` (A,), episode ends; agents whose episode ends leave ``active`` (in place). The numpy reference
-    of :func:`compiled_finish_step`."""
+    """The step's result once ``sim`` has moved: observations, rewards from the goal distances ``before`` (A,)
+    and those from the agents' new poses to ``goals`` (A, 2), episode ends; agents whose episode ends leave
+    ``active`` (in place). The numpy reference of :func:`compiled_finish_step`."""
+    distance, bearing = goal_polar(sim.true_poses[agents], goals)
     observations = observer.observe(sim, distance, bearing)
     outcome = score(reward, before, distance, sim.stalled[agents])
     result = step_result(outcome, observations, distance, active.copy(), at_limit)
@@ -132,48 +134,49 @@ def _kernels() -> ModuleType:
     return step_kernels
 
 
-def compiled_commands(action_map: ActionMap, actions: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """:func:`reference_commands` in one compiled pass (:mod:`stage_sim.envs.step_kernels`)."""
+def compiled_command_agents(sim: Simulation, agents: np.ndarray, action_map: ActionMap, actions: np.ndarray,
+                            active: np.ndarray) -> None:
+    """:func:`command_agents` in one compiled pass (:mod:`stage_sim.envs.step_kernels`), which writes the rows
+    of ``sim.commands`` and ``sim.last_command_us`` that :meth:`~stage_sim.sim.simulation.Simulation.set_velocities`
+    writes."""
     kernels = _kernels()
     if action_map.discrete:
-        chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
-        out = np.empty((chosen.size, 3))
-        kernels.discrete_commands(action_map.table, chosen, active, out)
+        kernels.discrete_commands(action_map.table, np.asarray(actions, dtype=np.int64).reshape(-1), active, agents,
+                                  sim.commands, sim.last_command_us, sim.sim_time_us)
     else:
-        wanted = np.asarray(actions, dtype=np.float64).reshape(-1, 2)
-        out = np.empty((wanted.shape[0], 3))
-        kernels.continuous_commands(wanted, action_map.low, action_map.high, active, out)
-    return out
+        kernels.continuous_commands(np.asarray(actions, dtype=np.float64).reshape(-1, 2), action_map.low,
+                                    action_map.high, active, agents, sim.commands, sim.last_command_us,
+                                    sim.sim_time_us)
 
 
 def compiled_finish_step(
-    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, distance: np.ndarray,
-    bearing: np.ndarray, before: np.ndarray, active: np.ndarray, at_limit: bool,
+    observer: ObservationBuilder, reward: RewardConfig, sim: Simulation, agents: np.ndarray, goals: np.ndarray,
+    before: np.ndarray, active: np.ndarray, at_limit: bool,
 ) -> StepResult:
-    """:func:`finish_step` in one compiled pass: observe, score and end episodes (goal distance and bearing
-    come from numpy, :func:`~stage_sim.envs.spaces.goal_polar`)."""
+    """:func:`finish_step` in one compiled pass: goal distance and bearing, observe, score and end episodes."""
     count = agents.size
     scans = sim.scans
     ranges = (scans[agents[0]][0].ranges[None] if count == 1
               else np.stack([scans[agent][0].ranges for agent in agents]))
     rows = np.empty((count, observer.layout.size), dtype=np.float32)
-    rewards = np.empty(count)
+    rewards, distance = np.empty(count), np.empty(count)
     flags = np.empty((4, count), dtype=np.bool_)
     was_active = active.copy()
+    weights, range_max = _constants(reward, observer.layout.range_max)
     _kernels().observe_and_score(
-        ranges, np.float32(observer.layout.range_max), observer.history, sim.velocities, sim.stalled, agents, distance,
-        bearing, observer.tail_low, observer.tail_high, before, active, at_limit, _weights(reward), rows, rewards,
-        flags)
+        ranges, range_max, observer.history, sim.true_poses, sim.velocities, sim.stalled, agents, goals,
+        observer.tail_low, observer.tail_high, before, active, at_limit, weights, rows, rewards, distance, flags)
     terminated, truncated, arrived, collided = flags
     return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
 
 
 @cache
-def _weights(reward: RewardConfig) -> np.ndarray:
-    """The reward's weights and tolerance as the kernel takes them (made once per config, not per step)."""
+def _constants(reward: RewardConfig, range_max: float) -> tuple[np.ndarray, np.float32]:
+    """The reward's weights and tolerance and the range scale as the kernel takes them (made once per task, not
+    per step)."""
     weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
     weights.flags.writeable = False
-    return weights
+    return weights, np.float32(range_max)
 
 
 class NavigationTask:
@@ -221,16 +224,16 @@ class NavigationTask:
 
     def step(self, actions: np.ndarray) -> StepResult:
         """Apply one action per agent (those of finished agents are ignored) and advance one step."""
-        compiled = self.sim.kernels == "numba"
-        make_commands = compiled_commands if compiled else reference_commands
-        finish = compiled_finish_step if compiled else finish_step
-        self.sim.set_velocities(self._agent_rows, make_commands(self.actions, actions, self.active))
-        self.sim.step()
+        sim, agents = self.sim, self._agent_rows
+        compiled = sim.kernels == "numba"
+        (compiled_command_agents if compiled else command_agents)(sim, agents, self.actions, actions, self.active)
+        sim.step()
         self.steps += 1
-        before = self.distance
-        self.distance, bearing = goal_polar(self.sim.true_poses[self._agent_rows], self.goals)
-        return finish(self._observer, self.config.reward, self.sim, self._agent_rows, self.distance, bearing, before,
-                      self.active, self.steps >= self.config.max_steps)
+        result = (compiled_finish_step if compiled else finish_step)(
+            self._observer, self.config.reward, sim, agents, self.goals, self.distance, self.active,
+            self.steps >= self.config.max_steps)
+        self.distance = result.distance
+        return result
 
     def frame(self) -> np.ndarray:
         """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""

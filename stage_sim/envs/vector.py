@@ -28,7 +28,7 @@ from gymnasium.vector.utils import batch_space
 
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar
-from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, body_commands, score, step_result
+from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, score, step_result
 from stage_sim.sim.simulation import SimulationBatch
 
 
@@ -64,7 +64,6 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         bounds = np.array([first.sim.robots[robot].settings.velocity_bounds] * num_envs, dtype=np.float64)
         self.actions = ActionMap(bounds, discrete)
         self._observer = ObservationBuilder(self.layout, [robot] * num_envs, [self.single_observation_space] * num_envs)
-        self._robot_row = np.array([robot])
         self._rngs: list[np.random.Generator | None] = [None] * num_envs
         self.goals = np.zeros((num_envs, 2))
         self.distance = np.zeros(num_envs)
@@ -146,14 +145,15 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
     def advance(self, actions: np.ndarray, moving: np.ndarray) -> StepResult:
         """Step the worlds in ``moving`` (the others stand) and score them as arrays: (W,) results, nothing
         for the worlds that stood. No reset: whoever calls it decides what an ended episode leads to."""
-        commands = body_commands(self.actions.commands(actions))
-        worlds = np.flatnonzero(moving)
+        commands = self.actions.commands(actions).tolist()  # Python floats: a robot's row set without an index array
+        worlds = np.flatnonzero(moving).tolist()
         stepping = [self.tasks[world].sim for world in worlds]
-        for world, sim in zip(worlds, stepping, strict=True):
-            sim.set_velocities(self._robot_row, commands[world:world + 1])
-        self._batch.step(stepping, worlds.tolist())
-        self.steps += moving
         robot, batch = self.robot, self._batch
+        for world, sim in zip(worlds, stepping, strict=True):
+            forward, turn = commands[world]
+            sim.set_velocity(robot, forward, 0.0, turn)
+        batch.step(stepping, worlds)
+        self.steps += moving
         if batch.whole:  # the stepped worlds' state as the batch holds it (the other worlds' rows are reset next)
             poses, velocity, stalled = batch.poses[:, robot], batch.velocities[:, robot], batch.stalled[:, robot]
             ranges = batch.ranges[:, self._beams]
