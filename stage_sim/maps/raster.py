@@ -104,14 +104,23 @@ class StaticRaster:
             flat = np.concatenate([body.outline for body in bodies] or [np.zeros(0, dtype=np.int64)])
             values = np.concatenate([np.full(body.outline.size, body.ranger_return) for body in bodies]
                                     or [np.zeros(0)])
-            layer = TileLayer.from_cells(self.grid, unique_sorted(flat))
-            self._cache[key] = (layer, CellValues.last_wins(flat, values))
+            self._cache[key] = (self._layer(seen, flat), CellValues.last_wins(flat, values))
         return self._cache[key]
 
     def collision_tiles(self, z_low: float, z_high: float) -> TileLayer:
-        """The cells that block a body spanning [z_low, z_high], in tiles."""
-        flat = [body.outline for body in self.bodies if body.blocks(z_low, z_high)]
-        return TileLayer.from_cells(self.grid, unique_sorted(np.concatenate(flat or [np.zeros(0, dtype=np.int64)])))
+        """The cells that block a body spanning [z_low, z_high], in tiles (the very layer rays see when the same
+        bodies block as are seen: an episode's world makes it once, not twice)."""
+        return self._layer(tuple(i for i, body in enumerate(self.bodies) if body.blocks(z_low, z_high)))
+
+    def _layer(self, chosen: tuple[int, ...], flat: np.ndarray | None = None) -> TileLayer:
+        """The outline cells of the bodies ``chosen`` (their ``flat`` outlines end to end, when at hand) in
+        tiles, made once per set of bodies (layers are never written to)."""
+        key = ("layer", chosen)
+        if key not in self._cache:
+            if flat is None:
+                flat = np.concatenate([self.bodies[i].outline for i in chosen] or [np.zeros(0, dtype=np.int64)])
+            self._cache[key] = TileLayer.from_cells(self.grid, unique_sorted(flat))
+        return self._cache[key]
 
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
         """(occupied, intensity) dense grids for rays at ``height`` (a picture: small worlds only)."""
