@@ -24,6 +24,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from stage_sim.maps.raster import StaticBody
+from stage_sim.maps.tiles import unique_sorted
 from stage_sim.sim.simulation import Simulation
 
 #: Candidates drawn per batch, and batches tried, before every valid cell is looked at.
@@ -81,14 +82,16 @@ class FreeSpace:
         same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
         blocked, clusters = self._blocked_with(sim) if same_grid else (None, None)
-        if blocked is None or (self._blocked & ~blocked).any():
+        if blocked is None or (clusters is None and (self._blocked & ~blocked).any()):
             return FreeSpace(sim, self._robots, self._margin)
-        added = blocked & ~self._blocked
+        if clusters is None:
+            added = blocked & ~self._blocked
+            added_cells = np.flatnonzero(added)
+            clusters = _clusters(added, added_cells)
+        else:  # only bodies added, each within its box: the grid is looked at there alone
+            added, added_cells = self._added_within(blocked, clusters)
         valid = self._valid.copy()
         pad = self._pad
-        added_cells = np.flatnonzero(added)
-        if clusters is None:
-            clusters = _clusters(added, added_cells)
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import clear_near
 
@@ -157,6 +160,19 @@ class FreeSpace:
                 boxes.append((slice(max(int(rows[0]) - 1, 0), int(rows[-1]) + 2),
                               slice(max(int(cols.min()) - 1, 0), int(cols.max()) + 2)))
         return blocked, boxes
+
+    def _added_within(self, blocked: np.ndarray, boxes: list[tuple[slice, slice]]) -> tuple[np.ndarray, np.ndarray]:
+        """The cells ``blocked`` holds and this space's blocked cells do not, all within ``boxes``: as a grid and
+        as sorted flat cells (what ``blocked & ~self._blocked`` and its ``flatnonzero`` give, without a pass over
+        the whole grid)."""
+        added = np.zeros_like(blocked)
+        flat = [np.zeros(0, dtype=np.int64)]
+        for rows, cols in boxes:
+            window = blocked[rows, cols] & ~self._blocked[rows, cols]
+            added[rows, cols] = window
+            local_rows, local_cols = np.nonzero(window)
+            flat.append((local_rows + rows.start) * self.width + local_cols + cols.start)
+        return added, unique_sorted(np.concatenate(flat))
 
     def _index(self, valid: np.ndarray, compiled: bool) -> None:
         """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the

@@ -166,7 +166,7 @@ def compiled_finish_step(
     _kernels().observe_and_score(
         ranges, range_max, observer.history, sim.true_poses, sim.velocities, sim.stalled, agents, goals,
         observer.tail_low, observer.tail_high, before, active, at_limit, weights, rows, rewards, distance, flags)
-    terminated, truncated, arrived, collided = flags
+    terminated, truncated, arrived, collided = flags[0], flags[1], flags[2], flags[3]  # unpacking iterates: slower
     return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
 
 
