@@ -1,9 +1,9 @@
 """Start-up: wall seconds from starting ``stageros rooms.world`` to its first /base_scan, cold and warm cache,
 and from starting ``stageros`` on a world of 1000 robots to its first /robot_0/base_scan.
 
-Run with the venv's python: ``.venv/bin/python benchmarks/startup.py [--runs N]``. Prints one JSON object
-per line: ``case`` ("cold cache": the default kernels with an empty numba cache folder, so numba compiles
-every kernel, in the background while the first steps run on numpy (sim/kernel_upgrade.py); "warm cache":
+Run with the venv's python: ``.venv/bin/python benchmarks/startup.py [--runs N] [--cases CASE ...]``. Prints
+one JSON object per line: ``case`` ("cold cache": the default kernels with an empty numba cache folder, so numba
+compiles every kernel, in the background while the first steps run on numpy (sim/kernel_upgrade.py); "warm cache":
 the same folder, now filled; "numba from the start": ``STAGE_SIM_KERNELS=numba``, the first scan waits for
 numba; "numpy kernels": no numba at all; "1000 robots": Stage's hospital.world benchmark, warm cache),
 ``world``, ``run``, ``simulation_built_s`` (stageros logs that its world is loaded and simulated and its
@@ -47,6 +47,7 @@ STAGEROS = Path(sys.executable).with_name("stageros")
 ROOMS = REPO / "worlds" / "rooms.world"
 CROWD = REPO / "tests" / "data" / "corpus" / "stage-worlds" / "benchmark" / "hospital.world"
 """Stage's own 1000-robot benchmark world, which travels with the tests' corpus."""
+CASES = ["cold cache", "warm cache", "numba from the start", "numpy kernels", "1000 robots"]
 
 
 @dataclass(frozen=True)
@@ -97,6 +98,9 @@ def main() -> None:
     use_private_domain(Path(__file__).name)  # a simulator running beside this benchmark must not be measured
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3, help="warm-cache runs (the cold run is one)")
+    parser.add_argument("--cases", nargs="+", choices=CASES, default=CASES, metavar="CASE",
+                        help=f"the cases to run, in this order: {', '.join(CASES)} (default: all; a warm "
+                             "cache is warm only after the cold one: the cache folder is new each time)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as cache:
         env = {key: value for key, value in os.environ.items() if key != "STAGE_SIM_KERNELS"}
@@ -106,6 +110,7 @@ def main() -> None:
         cases += [("numba from the start", dict(env, STAGE_SIM_KERNELS="numba"), rooms)] * args.runs
         cases += [("numpy kernels", dict(env, STAGE_SIM_KERNELS="numpy"), rooms)] * args.runs
         cases += [("1000 robots", env, (CROWD, "/robot_0/base_scan"))] * args.runs
+        cases = [case for case in cases if case[0] in args.cases]
         for run, (case, case_env, (world, topic)) in enumerate(cases):
             startup = first_scan(case_env, world, topic)
             print(json.dumps({"case": case, "world": world.name, "run": run,

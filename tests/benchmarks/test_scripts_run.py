@@ -27,7 +27,8 @@ TINY = {
                  "stage_sim vector env", "stage_sim core", "stage_sim rays"],
     "simulate": ["--robots", "1", "2", "--seconds", "0.5"],
     "stageros": ["--seconds", "1"],
-    "startup": ["--runs", "1"],
+    # No numba compile (a cold cache takes half a minute) and no 1000-robot world (the corpus tests start it).
+    "startup": ["--runs", "1", "--cases", "numpy kernels"],
     "stress": ["--quick", "--checks", "frozen", "complete", "kill9"],
     "view": ["--seconds", "1", "--cases", "cpu"],
     "wander_speed": ["--steps", "20"],
