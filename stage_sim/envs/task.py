@@ -172,8 +172,8 @@ def compiled_finish_step(
 
 @cache
 def _constants(reward: RewardConfig, range_max: float) -> tuple[np.ndarray, np.float32]:
-    """The reward's weights and tolerance and the range scale as the kernel takes them (made once per task, not
-    per step)."""
+    """The reward's weights and tolerance and the range scale as the kernel takes them (made once per reward and
+    laser range, not per step)."""
     weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
     weights.flags.writeable = False
     return weights, np.float32(range_max)
