@@ -167,6 +167,10 @@ class FusedStep:
             "headings": np.zeros((2 * n, 3)),  # column 2: a step's new headings (end poses, then odometry) ...
             "known": np.full((4, n), np.nan),  # ... the headings of the poses, odometry, layers 0 and 1 ...
             "known_trig": np.empty((4, 2, n)),  # ... and their cos and sin
+            # the last cast through each layer, kept for the steps whose robots stand still (shared by every pack)
+            "cast_keys": np.empty((2, 2, n, 3)), "cast_ranges": np.empty((3, beams)),
+            "cast_intensity": np.empty((3, beams), dtype=np.float32), "cast_state": np.zeros((2, 2), dtype=np.int64),
+            "replays": np.zeros(1, dtype=np.int64),
             **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
                        world, strict=True)),
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
@@ -220,6 +224,12 @@ class FusedStep:
     def beams(self) -> int:
         """Rays its steps cast."""
         return self._beams
+
+    @property
+    def replayed_casts(self) -> int:
+        """Casts answered by the kept one, its robots having stood still since
+        (:func:`~stage_sim.sim.fused_kernels._cast_kept`)."""
+        return int(self._fields["replays"][0])
 
     def world(self) -> fused_kernels.FusedWorld:
         """What its kernels read besides the robots' state, with the robot layer's tables as they stand."""

@@ -51,6 +51,10 @@ FIELDS = (
     "static_cells", "static_values", "robot_return", "several_return",
     # scratch: ranges, hit cells and robots; new headings, the remembered ones and their cos and sin
     "ranges", "cell", "hit_robot", "headings", "known", "known_trig",
+    # the last cast through each layer, kept (see _cast_kept): the poses it was cast from and the layer's poses
+    # it saw; its ranges before the noise and its intensities (a third row: the last walk's); per layer whether
+    # one is kept and the tiles it needed; how often one was replayed
+    "cast_keys", "cast_ranges", "cast_intensity", "cast_state", "replays",
 )
 
 
@@ -76,7 +80,8 @@ def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, c
                 marked_count, active, walk_rows, walk_cols, walk_tiles, walk_slots, walk_rows_used, walk_cols_used,
                 walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin,
                 jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return,
-                several_return, ranges, cell, hit_robot, headings, known, known_trig):
+                several_return, ranges, cell, hit_robot, headings, known, known_trig, cast_keys, cast_ranges,
+                cast_intensity, cast_state, replays):
     """A :class:`FusedWorld` of the :data:`FIELDS` (compiled and cached: the proxy's own constructor is not)."""
     return FusedWorld(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
                       tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids,
@@ -85,7 +90,7 @@ def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, c
                       walk_rows_used, walk_cols_used, walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner,
                       rays, last_angle, last_cos, last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss,
                       static_cells, static_values, robot_return, several_return, ranges, cell, hit_robot, headings,
-                      known, known_trig)
+                      known, known_trig, cast_keys, cast_ranges, cast_intensity, cast_state, replays)
 
 
 @numba.njit(**_JIT)
@@ -282,11 +287,15 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
         known[1, i] = odometry[i, 2]
     if not cast:
         return 0
+    if _cast_kept(world, layer, final, layers[layer]):
+        return _replay(world, layer, published, intensity)
     if count == n and not refused.any():  # every robot where it was tested: the rays see the raster it was tested in
         cells, cell_robot = end_cells, end_robot
     else:
         cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
-    return sense(world, final, final_trig, cells, cell_robot, published, intensity)
+    needed = sense(world, final, final_trig, cells, cell_robot, published, intensity)
+    _keep_cast(world, layer, final, layers[layer], needed)
+    return needed
 
 
 @numba.njit(**_JIT)
@@ -299,7 +308,52 @@ def sense_again(world, layers, layer, poses, trig, published, intensity):
     known_trig = world.known_trig
     cells, cell_robot = _raster(world, np.arange(poses.shape[0]), layers[layer], known_trig[row, 0],
                                 known_trig[row, 1])
-    return sense(world, poses, trig, cells, cell_robot, published, intensity)
+    needed = sense(world, poses, trig, cells, cell_robot, published, intensity)
+    _keep_cast(world, layer, poses, layers[layer], needed)
+    return needed
+
+
+@numba.njit(**_JIT)
+def _cast_kept(world, layer, poses, raster):
+    """Whether the cast kept for layer ``layer`` (:func:`_keep_cast`) is this one's: the robots are where it was
+    cast from and where the layer had them then, bit for bit. A walk's answer depends on nothing else that can
+    change (the static world, the beams and their ranges are the world's for good; a direction noise, which
+    would change it, keeps nothing), so a world whose robots stand still (parked, or stalled against a wall)
+    does not walk its rays again, where Stage walks them every update. One kept per layer: a robot that
+    stopped stays a step behind in the layer it did not move in last, and the steps alternate the layers."""
+    if not world.cast_state[layer, 0]:
+        return False
+    keys = world.cast_keys[layer]
+    for i in range(poses.shape[0]):
+        for axis in range(3):
+            if not (_same(poses[i, axis], keys[0, i, axis]) and _same(raster[i, axis], keys[1, i, axis])):
+                return False
+    return True
+
+
+@numba.njit(**_JIT)
+def _keep_cast(world, layer, poses, raster, needed):
+    """Keep the walk just made from ``poses`` through layer ``layer`` holding the robots at ``raster`` (its
+    ranges before the noise and intensities, which :func:`sense` left in the last row), unless it was not made
+    (``needed`` more tiles than the layer has) or its rays have a direction noise (drawn anew for every cast)."""
+    if needed > world.capacity or world.jitter.size:
+        return
+    world.cast_keys[layer, 0] = poses
+    world.cast_keys[layer, 1] = raster
+    world.cast_ranges[layer] = world.cast_ranges[2]
+    world.cast_intensity[layer] = world.cast_intensity[2]
+    world.cast_state[layer, 0], world.cast_state[layer, 1] = 1, needed
+
+
+@numba.njit(**_JIT)
+def _replay(world, layer, published, intensity):
+    """The cast kept for layer ``layer``, with this cast's range noise: what :func:`sense` would give (it walks the
+    same rays through the same cells); the tiles it needed."""
+    world.ranges[:] = world.cast_ranges[layer]
+    intensity[:] = world.cast_intensity[layer]
+    _publish(world, published)
+    world.replays[0] += 1
+    return world.cast_state[layer, 1]
 
 
 @numba.njit(**_JIT)
@@ -312,7 +366,9 @@ def sense(world, poses, trig, cells, cell_robot, published, intensity):
 
     With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
     layer's tiles, else their regions are only marked. Returns the tiles needed; when the layer has room for
-    fewer (``world.capacity``) nothing is cast: the caller grows it and calls again."""
+    fewer (``world.capacity``) nothing is cast: the caller grows it and calls again. Leaves the ranges before the
+    noise and the intensities in the last row of ``cast_ranges`` and ``cast_intensity``: the caller, who knows
+    the layer, keeps them (:func:`_keep_cast`)."""
     w = world
     origins = np.empty((w.ranger_offset.shape[0], 2))
     motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)
@@ -341,6 +397,17 @@ def sense(world, poses, trig, cells, cell_robot, published, intensity):
         (w.last_angle, w.last_cos, w.last_sin), w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
     ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
                                  w.several, w.several_return, w.rays, intensity)
+    w.cast_ranges[2] = ranges
+    w.cast_intensity[2] = intensity
+    _publish(w, published)
+    return count
+
+
+@numba.njit(**_JIT)
+def _publish(w, published):
+    """The range noise drawn for this cast on the walk's ranges (r + r·p·U' + G for a hit), as float32 into
+    ``published``."""
+    ranges = w.ranges
     noisy_rays, rmax, prop, uniform, gauss = w.noisy_rays, w.rmax, w.noise_prop, w.noise_uniform, w.noise_gauss
     for k in range(noisy_rays.size):
         i = noisy_rays[k]
@@ -348,4 +415,3 @@ def sense(world, poses, trig, cells, cell_robot, published, intensity):
             ranges[i] = ranges[i] + ranges[i] * prop[k] * uniform[k] + gauss[k]
     for i in range(ranges.size):
         published[i] = np.float32(ranges[i])
-    return count

@@ -130,3 +130,40 @@ def test_the_fused_step_on_a_mixed_world_gives_the_reference_answers():
     reference = _frames(Simulation(world, seed=3, kernels="numpy"), 40, 3)
     assert _frames(fused, 40, 3) == reference
     assert _frames(by_roles, 40, 3) == reference
+
+
+def _still_frames(sim: Simulation) -> list[tuple]:
+    """Every step's state while the robots stand still, one is pushed against another (stalled), robots are set
+    where they are and elsewhere, and all go back to their start."""
+    frames = []
+    for step in range(60):
+        if step in (3, 6):  # moves for some steps, then stands still: one layer holds it where it was a step ago
+            sim.set_velocity(4, 0.6 if step == 3 else 0.0, 0.0, 0.0)
+        if step == 10:
+            sim.set_velocity(0, 1.0, 0.0, 0.0)  # drives into the robot ahead of it and stalls there
+        if step == 30:
+            sim.set_pose(1, *sim.true_poses[1])  # where it is: the same cast
+        if step == 40:
+            sim.set_pose(1, 1.5, 1.5, 0.5)
+        if step == 50:
+            sim.reset_positions()
+        sim.step()
+        scans = [(s.ranges.tobytes(), s.intensities.tobytes(), s.stamp) for robot in sim.scans for s in robot]
+        frames.append((sim.true_poses.tobytes(), sim.odometry_poses.tobytes(), sim.stalled.tobytes(), scans))
+    return frames
+
+
+@pytest.mark.parametrize("angle_noise", [False, True])
+def test_robots_standing_still_are_not_cast_again_and_get_the_reference_answers(angle_noise):
+    """A fused step whose robots are all where they were (parked, stalled) answers with the last cast and this
+    step's range noise instead of walking every ray again; the answers stay the reference's. A direction noise
+    changes every cast: nothing is kept."""
+    text = MIXED.replace("noise [0.0 0.02 0.0]", "noise [0.0 0.02 0.5]") if angle_noise else MIXED
+    world = load_world_text(text, "mixed.world")
+    fused = Simulation(world, seed=5, kernels="numba")
+    assert fused._fused is not None
+    frames = _still_frames(fused)
+    assert frames == _still_frames(Simulation(world, seed=5, kernels="numpy"))
+    assert np.frombuffer(frames[25][2], dtype=bool)[0], "the pushing robot stalls"
+    replayed = fused._fused.replayed_casts
+    assert replayed == 0 if angle_noise else replayed >= 35
