@@ -98,7 +98,9 @@ class RangerSensing:
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
         self._no_jitter = np.zeros(0)
         self._all_cast = self._all_cast_noise()
-        self.latest: list[list[Scan]] = [[] for _ in robots]
+        self._latest: list[list[Scan]] = [[] for _ in robots]
+        self._unpublished: tuple[np.ndarray, np.ndarray, float] | None = None
+        """A fused step's cast of every ranger (float32 ranges, intensities, time) not made into scans yet."""
         self.measured: MeasuredBeams | None = None
         """The beams of the last sensing that cast any (None before the first)."""
         self._rng = np.random.default_rng()
@@ -119,13 +121,24 @@ class RangerSensing:
     def adopt(self, previous: RangerSensing) -> None:
         """Carry on where ``previous`` (the same rangers on other kernels) stands: its latest scans, schedule,
         pending re-scan and random generator."""
-        self.latest = previous.latest
+        self._latest = previous.latest
         self.measured = previous.measured
         self._last_us = previous._last_us.copy()
         self._all_due_us = previous._all_due_us
         self._next_due_us = previous._next_due_us
         self._stale = previous._stale
         self._rng = previous._rng
+
+    @property
+    def latest(self) -> list[list[Scan]]:
+        """The latest scan of every ranger, per robot; those of a fused step's cast are made when first read: a
+        run that reads no scans (a vector env, a benchmark, a bag, which keeps :attr:`measured`) makes none
+        (some 2 µs a step for one robot)."""
+        if self._unpublished is not None:
+            published, intensity, time = self._unpublished
+            self._unpublished = None
+            self._publish(range(len(self._rangers)), published, intensity, time)
+        return self._latest
 
     def invalidate(self) -> None:
         """Make every ranger due at the next :meth:`sense` (after a reset: cheap, however often it comes)."""
@@ -208,7 +221,7 @@ class RangerSensing:
         """Take the scans of every ranger cast at ``time`` by a fused step (when :meth:`all_due`): what
         :meth:`sense` keeps of its own cast."""
         self._mark_all_cast(round(time * 1e6))
-        self._publish(range(len(self._rangers)), published, intensity, time)
+        self._unpublished = published, intensity, time
         self.measured = MeasuredBeams(time, published, intensity, None, None)
 
     def _mark_all_cast(self, now_us: int) -> None:
@@ -220,10 +233,11 @@ class RangerSensing:
 
     def _publish(self, rangers: Iterable[int], published: np.ndarray, intensity: np.ndarray, time: float) -> None:
         """New scans of ``rangers`` from the float32 ranges and intensities of all beams (views of their own)."""
+        latest = self.latest  # after the scans of a cast not made into scans yet
         for k in rangers:
             robot_index, ranger_index, part = self._scan_slots[k]
             scan = Scan(published[part], intensity[part], time)
-            robot_scans = self.latest[robot_index]
+            robot_scans = latest[robot_index]
             if ranger_index < len(robot_scans):
                 robot_scans[ranger_index] = scan
             else:

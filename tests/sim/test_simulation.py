@@ -244,6 +244,29 @@ def test_scans_follow_the_post_move_pose_and_update_interval() -> None:
     assert stamps == [0.0, 0.2, 0.2, 0.4]
 
 
+def test_scans_read_late_are_the_scans_read_at_every_step() -> None:
+    """A fused step's scans are made when first read: a reader who looks only now and then (after steps that
+    cast every ranger, and after steps that cast one of them) gets what a reader at every step got."""
+    two = ROOM.format(drive="diff", extra='laser( pose [-0.1 0 -0.1 180] update_interval 200 )')
+    text = two + 'bot( pose [2 5 0 0] ) bot( pose [6 6 0 90] )'
+
+    def scans(sim: Simulation) -> list[tuple]:
+        return [(s.ranges.tobytes(), s.intensities.tobytes(), s.stamp) for robot in sim.scans for s in robot]
+
+    eager, late = (Simulation(load_world_text(text, "two.world"), seed=2, kernels="numba") for _ in range(2))
+    assert eager._fused is not None
+    seen = []
+    for step in range(12):
+        for sim in (eager, late):
+            sim.set_velocity(0, 0.3, 0.0, 0.2 * (-1) ** (step // 3))
+            sim.step()
+        seen.append(scans(eager))
+        if step in (4, 7, 8, 11):
+            assert scans(late) == seen[-1]
+    assert {stamp for _, _, stamp in seen[-1]} == {1.2}
+    assert {stamp for _, _, stamp in seen[-2]} == {1.0, 1.1}, "the slow laser's last scan is a step older"
+
+
 def test_low_obstacles_are_invisible_to_high_lasers_and_transparent_ones_to_all() -> None:
     low = 'model( size [0.5 0.5 0.05] pose [5 5 0 0] )\n'
     sim = sim_of('bot( pose [2 5 0 0] )', more=low)
