@@ -168,8 +168,8 @@ class FusedStep:
             "known": np.full((4, n), np.nan),  # ... the headings of the poses, odometry, layers 0 and 1 ...
             "known_trig": np.empty((4, 2, n)),  # ... and their cos and sin
             # the last cast through each layer, kept for the steps whose robots stand still (shared by every pack)
-            "cast_keys": np.empty((2, 2, n, 3)), "cast_ranges": np.empty((3, beams)),
-            "cast_intensity": np.empty((3, beams), dtype=np.float32), "cast_state": np.zeros((2, 2), dtype=np.int64),
+            "cast_keys": np.empty((2, 2, n, 3)), "cast_ranges": np.empty((2, beams)),
+            "cast_intensity": np.empty((2, beams), dtype=np.float32), "cast_state": np.zeros((2, 2), dtype=np.int64),
             "replays": np.zeros(1, dtype=np.int64),
             **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
                        world, strict=True)),
@@ -257,7 +257,7 @@ class FusedStep:
         fused_kernels.sense_again(self._world, layers, 0, poses, final_trig, np.empty(self._beams, dtype=np.float32),
                                   np.empty(self._beams, dtype=np.float32))
         fused_kernels.sense(self._world, poses, final_trig, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
-                            np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32))
+                            np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32), 0)
 
 
 class FusedBatch:

@@ -52,8 +52,8 @@ FIELDS = (
     # scratch: ranges, hit cells and robots; new headings, the remembered ones and their cos and sin
     "ranges", "cell", "hit_robot", "headings", "known", "known_trig",
     # the last cast through each layer, kept (see _cast_kept): the poses it was cast from and the layer's poses
-    # it saw; its ranges before the noise and its intensities (a third row: the last walk's); per layer whether
-    # one is kept and the tiles it needed; how often one was replayed
+    # it saw; its ranges before the noise and its intensities; per layer whether one is kept and the tiles it
+    # needed; how often one was replayed
     "cast_keys", "cast_ranges", "cast_intensity", "cast_state", "replays",
 )
 
@@ -293,7 +293,7 @@ def step(world, poses, integrated, layers, layer, velocities, stalled, odometry,
         cells, cell_robot = end_cells, end_robot
     else:
         cells, cell_robot = _raster(world, np.arange(n), layers[layer], known_trig[row, 0], known_trig[row, 1])
-    needed = sense(world, final, final_trig, cells, cell_robot, published, intensity)
+    needed = sense(world, final, final_trig, cells, cell_robot, published, intensity, layer)
     _keep_cast(world, layer, final, layers[layer], needed)
     return needed
 
@@ -308,7 +308,7 @@ def sense_again(world, layers, layer, poses, trig, published, intensity):
     known_trig = world.known_trig
     cells, cell_robot = _raster(world, np.arange(poses.shape[0]), layers[layer], known_trig[row, 0],
                                 known_trig[row, 1])
-    needed = sense(world, poses, trig, cells, cell_robot, published, intensity)
+    needed = sense(world, poses, trig, cells, cell_robot, published, intensity, layer)
     _keep_cast(world, layer, poses, layers[layer], needed)
     return needed
 
@@ -334,14 +334,12 @@ def _cast_kept(world, layer, poses, raster):
 @numba.njit(**_JIT)
 def _keep_cast(world, layer, poses, raster, needed):
     """Keep the walk just made from ``poses`` through layer ``layer`` holding the robots at ``raster`` (its
-    ranges before the noise and intensities, which :func:`sense` left in the last row), unless it was not made
+    ranges before the noise and intensities, which :func:`sense` left in the layer's row), unless it was not made
     (``needed`` more tiles than the layer has) or its rays have a direction noise (drawn anew for every cast)."""
     if needed > world.capacity or world.jitter.size:
         return
     world.cast_keys[layer, 0] = poses
     world.cast_keys[layer, 1] = raster
-    world.cast_ranges[layer] = world.cast_ranges[2]
-    world.cast_intensity[layer] = world.cast_intensity[2]
     world.cast_state[layer, 0], world.cast_state[layer, 1] = 1, needed
 
 
@@ -357,7 +355,7 @@ def _replay(world, layer, published, intensity):
 
 
 @numba.njit(**_JIT)
-def sense(world, poses, trig, cells, cell_robot, published, intensity):
+def sense(world, poses, trig, cells, cell_robot, published, intensity, keep):
     """Every ray of one height cast from ``poses`` (their cos and sin ``trig``, (2, N)) as
     :meth:`~stage_sim.sim.rangers.RangerSensing.sense` casts them when all rangers are due: the rangers'
     origins, the robot layer from the robots' raster (``cells``, ``cell_robot``; the layer's marked regions and
@@ -366,9 +364,10 @@ def sense(world, poses, trig, cells, cell_robot, published, intensity):
 
     With ``world.robots_seen`` (more than one robot) the robots' cells are numbered and written into the
     layer's tiles, else their regions are only marked. Returns the tiles needed; when the layer has room for
-    fewer (``world.capacity``) nothing is cast: the caller grows it and calls again. Leaves the ranges before the
-    noise and the intensities in the last row of ``cast_ranges`` and ``cast_intensity``: the caller, who knows
-    the layer, keeps them (:func:`_keep_cast`)."""
+    fewer (``world.capacity``) nothing is cast: the caller grows it and calls again. Unless the rays have a
+    direction noise, leaves the ranges before the noise and the intensities in row ``keep`` (the layer cast
+    through) of ``cast_ranges`` and ``cast_intensity``, that row no longer kept: the caller keeps it, with where
+    the robots were (:func:`_keep_cast`)."""
     w = world
     origins = np.empty((w.ranger_offset.shape[0], 2))
     motion_kernels.place_points(w.ranger_offset, w.ranger_owner, poses, trig[0], trig[1], origins)
@@ -397,8 +396,10 @@ def sense(world, poses, trig, cells, cell_robot, published, intensity):
         (w.last_angle, w.last_cos, w.last_sin), w.rmax, w.walk_ppm, w.owner, w.rays, ranges, w.cell, w.hit_robot)
     ranger_kernels.hit_intensity(w.cell, w.hit_robot, w.static_cells, w.static_values, w.robot_return, w.robots_seen,
                                  w.several, w.several_return, w.rays, intensity)
-    w.cast_ranges[2] = ranges
-    w.cast_intensity[2] = intensity
+    if not w.jitter.size:
+        w.cast_state[keep, 0] = 0
+        w.cast_ranges[keep] = ranges
+        w.cast_intensity[keep] = intensity
     _publish(w, published)
     return count
 

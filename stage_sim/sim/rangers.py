@@ -133,7 +133,7 @@ class RangerSensing:
     def latest(self) -> list[list[Scan]]:
         """The latest scan of every ranger, per robot; those of a fused step's cast are made when first read: a
         run that reads no scans (a vector env, a benchmark, a bag, which keeps :attr:`measured`) makes none
-        (some 2 µs a step for one robot)."""
+        (about 1.5 µs a step for one robot)."""
         if self._unpublished is not None:
             published, intensity, time = self._unpublished
             self._unpublished = None
