@@ -20,7 +20,8 @@ from __future__ import annotations
 import math
 import struct
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -90,6 +91,8 @@ class _Block:
         self._every = [(begin + at, end + at) for at in range(0, steps * self.stride, self.stride)
                        for begin, end in self.spans]
         """Every message's span in the buffer, step after step (what :meth:`messages` cuts)."""
+        self._cuts: dict[int, Callable[[bytes], Sequence[bytes]]] = {}
+        """Per number of steps, what cuts the messages of that many out of the block's bytes."""
         self.f64 = np.frombuffer(self.buffer, "<f8", len(self.buffer) // 8)
         self.f32 = np.frombuffer(self.buffer, "<f4", len(self.buffer) // 4)
         self.i32 = np.frombuffer(self.buffer, "<i4", len(self.buffer) // 4)
@@ -113,12 +116,15 @@ class _Block:
         sec, nanosec = fields.stamp_parts(np.asarray(sim_times_us, dtype=np.int64)[:, None])
         self.i32[at], self.u32[at + 1] = sec, nanosec
 
-    def messages(self, steps: int) -> list[bytes | None]:
-        """Every message's bytes as they are now, of the first ``steps`` steps, step after step (one list: the
-        writer's Python per message was most of its CPU). Each is copied once, straight out of the buffer: two
-        copies of the whole block first, then the cut, cost 3.5 times as much with 100 robots' scans."""
-        view = memoryview(self.buffer)
-        return [bytes(view[begin:end]) for begin, end in self._every[:steps * len(self.spans)]]
+    def messages(self, steps: int) -> Sequence[bytes | None]:
+        """Every message's bytes as they are now, of the first ``steps`` steps, step after step: the block copied
+        once into bytes, then cut by one C call (an itemgetter of every message's slice). A Python loop that
+        copied each message straight out of the buffer cost 2.5 times as much, for 1 robot as for 100."""
+        if steps not in self._cuts:
+            every = [slice(begin, end) for begin, end in self._every[:steps * len(self.spans)]]
+            # itemgetter returns a tuple, except of one item
+            self._cuts[steps] = itemgetter(*every) if len(every) > 1 else lambda data: (data[every[0]],)
+        return self._cuts[steps](bytes(memoryview(self.buffer)[:self._every[steps * len(self.spans) - 1][1]]))
 
 
 class Layout(ABC):
@@ -149,7 +155,7 @@ class Layout(ABC):
         return {"stamp": block.index(every, [HEADER] * len(self._templates), 4)}
 
     @abstractmethod
-    def refill(self, values: Any, sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: Any, sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         """Each endpoint's message bytes for the steps' ``values`` (the topic's :attr:`Topic.values` with a
         leading axis per step), step after step, None for an endpoint that publishes nothing in that step."""
 
@@ -166,7 +172,7 @@ def _steps_of(values: Any) -> Any:
 class ClockLayout(Layout):
     """rosgraph_msgs/Clock: the stamp is the message."""
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         block.stamp(self._fields["stamp"][:steps], sim_times_us)
@@ -179,7 +185,7 @@ class BoolLayout(Layout):
     def _index(self, block: _Block) -> dict[str, np.ndarray]:
         return {"data": block.index(range(len(self._templates)), [HEADER] * len(self._templates), 1)}
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         block.u8[self._fields["data"][:steps]] = values[:, self._robots]
@@ -195,7 +201,7 @@ class OdometryLayout(Layout):
         return {**super()._index(block), "pose": block.index(every, poses, 8),
                 "twist": block.index(every, [pose + (7 + 36) * 8 for pose in poses], 8)}  # after the covariance
 
-    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: tuple[np.ndarray, np.ndarray], sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         poses, velocities = values[0][:, self._robots], values[1][:, self._robots]
@@ -240,7 +246,7 @@ class ScanLayout(Layout):
             self._gather = (rows.first, rows.lengths, gather)
         return self._gather[2]
 
-    def refill(self, values: ScanRows, sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: ScanRows, sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         if not values.measured.all():
@@ -256,7 +262,7 @@ class ScanLayout(Layout):
             rows[:, in_intensities:in_intensities + beams] = intensities[:, first:first + beams]
         return block.messages(steps)
 
-    def _refill_step(self, scans: PackedScans, step: int, sim_time_us: int) -> list[bytes | None]:
+    def _refill_step(self, scans: PackedScans, step: int, sim_time_us: int) -> Sequence[bytes | None]:
         """One step in which some rangers took no scan (they are slower than the step): those that did, one by
         one."""
         block, out = self._block, []
@@ -295,7 +301,7 @@ class TransformsLayout(Layout):
                 offset = translation + 7 * 8
         return {"stamp": block.index(message, stamps, 4), "translation": block.index(message, translations, 8)}
 
-    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> list[bytes | None]:
+    def refill(self, values: np.ndarray, sim_times_us: np.ndarray) -> Sequence[bytes | None]:
         steps = len(sim_times_us)
         block = self._fit(steps)
         poses = np.tile(values, (1, len(self._templates), 1))  # every message holds every robot's

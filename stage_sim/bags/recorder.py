@@ -1,14 +1,17 @@
 """Record a running simulation into an MCAP bag without holding up its steps.
 
 After every step the stepping thread keeps what the step published in a :class:`StepBatch` and goes on; a
-batch of steps at a time goes into a bounded queue, from which a sender thread pipes it to the bag's writer
-process (:mod:`stage_sim.bags.writer`), which makes and writes the messages on another core. When the queue
-is full (the writer or the disk cannot keep up):
+batch of steps at a time is piped to the bag's writer process (:mod:`stage_sim.bags.writer`), which makes and
+writes the messages on another core. When the writer or the disk cannot keep up:
 
 * a lossless recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
-  for the writer: the simulation slows down and every step is recorded;
-* a real-time recording drops the batch rather than fall behind the wall clock: its steps are counted, the
-  count is said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
+  for the writer: the simulation slows down and every step is recorded. The stepping thread pipes each batch
+  itself, and the pipe's blocking write is the wait. A thread of its own would cost more than the write: it
+  takes the interpreter lock between the simulation's compiled calls, which made a one-robot step 10-40 %
+  slower;
+* a real-time recording drops the batch rather than fall behind the wall clock: a sender thread pipes the
+  batches from a bounded queue, and when the queue is full the batch's steps are counted, the count is said
+  at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
 
 A write error (full disk, file size limit) stops the recording with one message on stderr; the simulation
 goes on and the file stays readable up to its last chunk.
@@ -37,10 +40,14 @@ from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan, se
 from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
-BATCH_BYTES = 1024 * 1024
-"""Bytes of steps sent to the writer at once (at most 64 steps): one message and one wake-up of the writer per
-batch instead of per step."""
+BATCH_BYTES = 256 * 1024
+"""Bytes of steps sent to the writer at once (at most BATCH_STEPS steps): one message and one wake-up of the
+writer per batch instead of per step."""
 BATCH_STEPS = 64
+PIPE_BYTES = 4 * BATCH_BYTES
+"""What the pipe to the writer holds (Linux: as far as the system's pipe-max-size allows, 1 MiB by default):
+the buffer of a lossless recording, whose stepping thread waits only when it is full. Four batches, not one:
+with one, the simulation and the writer took turns (100 robots: each waited 2-4 ms a batch)."""
 WAKE_S = 0.1
 """Wall seconds a step waits at most before its batch is sent, however small: a slow (real-time) recording
 reaches the writer, and the disk, within this."""
@@ -135,8 +142,11 @@ class BagRecorder:
         """Batches the sender has sent, to be filled again: their memory is already mapped (a fresh 1 MiB batch
         costs the stepping thread a page fault every 4 kB it fills)."""
         self._pending_since = 0.0
-        self._thread = threading.Thread(target=self._send, name="bag-sender", daemon=True)
-        self._thread.start()
+        self._thread: threading.Thread | None = None
+        """The sender of a real-time recording (a lossless one pipes its batches from the stepping thread)."""
+        if not self.lossless:
+            self._thread = threading.Thread(target=self._send, name="bag-sender", daemon=True)
+            self._thread.start()
 
     @property
     def writer_pid(self) -> int:
@@ -164,7 +174,13 @@ class BagRecorder:
             self._hand_over(wait=self.lossless)
 
     def _hand_over(self, wait: bool) -> None:
-        """Queue the pending steps; when the queue is full, wait for room if ``wait``, else drop them."""
+        """Pipe the pending steps to the writer (lossless), or queue them for the sender; when the queue is full,
+        wait for room if ``wait``, else drop them."""
+        if self._thread is None:
+            if not self.failed:
+                self._pipe(self._pending)
+            self._pending.clear()
+            return
         batch, self._pending = self._pending, self._empty_batch()
         if self.failed:
             return
@@ -190,7 +206,7 @@ class BagRecorder:
 
     def _wait_for_room(self, batch: StepBatch) -> bool:
         """Queue ``batch`` once the writer has made room; False if the recording stopped meanwhile."""
-        while self._thread.is_alive() and not self.failed:
+        while self._thread is not None and self._thread.is_alive() and not self.failed:
             try:
                 self._queue.put(batch, timeout=WAKE_S)
                 return True
@@ -203,8 +219,9 @@ class BagRecorder:
         to call once, also after errors; re-raises (as RuntimeError) a bug that crashed the writer."""
         if self._pending.count:
             self._hand_over(wait=True)  # nothing is paced any more: the last steps are never dropped
-        self._queue.put(None)
-        self._thread.join()
+        if self._thread is not None:
+            self._queue.put(None)
+            self._thread.join()
         if not self._writer_lost:
             try:
                 send_finish(self._steps, Finish({"dropped_steps": str(self.dropped_steps),
@@ -230,13 +247,18 @@ class BagRecorder:
         """The sender thread: pipe each queued batch to the writer (its buffer, off the stepping thread), until
         the closing None; if the writer has gone, the batches are dropped (close says why)."""
         while (batch := self._queue.get()) is not None:
-            if not self._writer_lost:
-                try:
-                    send_batch(self._steps, batch)
-                except OSError:
-                    self._writer_lost = True
+            self._pipe(batch)
             self._spare.put(batch)
-            self._read_reports()
+
+    def _pipe(self, batch: StepBatch) -> None:
+        """Send ``batch`` to the writer (waiting while the pipe is full), then take the reports that have come;
+        if the writer has gone, the batch is dropped (close says why)."""
+        if not self._writer_lost:
+            try:
+                send_batch(self._steps, batch)
+            except OSError:
+                self._writer_lost = True
+        self._read_reports()
 
     def _next_report(self, timeout: float | None) -> Opened | Failed | Closed | None:
         """The writer's next report, None if it ended (or ``timeout`` passed) without one."""
@@ -283,10 +305,10 @@ then read this one's plan with other code)."""
 
 
 def _widen(pipe: int) -> None:
-    """Let the steps pipe hold a whole batch (BATCH_BYTES; Linux: as far as the system's pipe-max-size allows),
-    so that sending one wakes the writer once, not once per 64 kB of the default pipe."""
+    """Let the steps pipe hold PIPE_BYTES, so that sending a batch wakes the writer once, not once per 64 kB of
+    the default pipe, and the simulation runs a few batches ahead of the writer."""
     with contextlib.suppress(AttributeError, OSError):  # not Linux, or a lower limit: the default pipe works
-        fcntl.fcntl(pipe, fcntl.F_SETPIPE_SZ, BATCH_BYTES)
+        fcntl.fcntl(pipe, fcntl.F_SETPIPE_SZ, PIPE_BYTES)
 
 
 def _start_writer() -> tuple[subprocess.Popen, Connection, Connection]:

@@ -67,7 +67,7 @@ def test_refilled_bytes_are_the_library_serialisation(tmp_path, topic, chosen, w
         received = travelled(batch)
         (values,) = received.values()
         refilled = layout.refill(values, received.times)
-        assert refilled == [data for step in expected for data in step]  # step after step
+        assert list(refilled) == [data for step in expected for data in step]  # step after step
         assert layout.count(values) == sum(data is not None for step in expected for data in step)
         compared += sum(data is not None for step in expected for data in step)
     assert compared >= 12 * len(endpoints) // 2  # scans too: the rangers measure in most steps
