@@ -156,14 +156,13 @@ class BagRecorder:
     @property
     def failed(self) -> bool:
         """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded). Cheap
-        enough for every step: the sender thread reads the writer's reports, the stepping thread only these
-        flags (a system call here, once per step, let the sender take the interpreter lock in the middle of
-        the simulation's step)."""
+        enough for every step: only flags, which the writer's reports set as a batch is piped (a system call
+        per step here cost as much as keeping the step)."""
         return self.error is not None or self._writer_lost or self._closed is not None
 
     def record_step(self) -> None:
-        """Keep what the step just taken published; every batch's worth (or WAKE_S), queue it for the writer:
-        a full queue makes a lossless recording wait and a real-time one drop the batch."""
+        """Keep what the step just taken published; every batch's worth (or WAKE_S), hand it to the writer: a
+        lossless recording waits for room, a real-time one drops the batch when its queue is full."""
         if self.error is not None:
             return
         now = time.monotonic()
@@ -272,8 +271,8 @@ class BagRecorder:
             return None
 
     def _read_reports(self) -> None:
-        """Take the reports that have come, without waiting (the sender thread, once per batch: hence select,
-        not Connection.poll, which builds a selector per call)."""
+        """Take the reports that have come, without waiting (once per batch piped: hence select, not
+        Connection.poll, which builds a selector per call)."""
         while not self._reports.closed and ready([self._reports], [], [], 0)[0]:
             try:
                 self._take(self._reports.recv())
