@@ -136,12 +136,24 @@ class ObservationBuilder:
         return rows
 
     def _ranges(self, sim: Simulation) -> np.ndarray:
-        return np.stack([sim.scans[i][0].ranges for i in self.agents])
+        return first_laser_ranges(sim, self.agents)
 
     def _normalise(self, ranges: np.ndarray, out: np.ndarray) -> None:
         """Ranges divided by the range and clipped to [0, 1], into ``out`` (A, B)."""
         np.divide(ranges, self.layout.range_max, out=out)
         np.clip(out, 0.0, 1.0, out=out)
+
+
+def first_laser_ranges(sim: Simulation, robots: np.ndarray) -> np.ndarray:
+    """(A, B) float32: the newest ranges of each robot's first laser. When the last cast measured every ranger,
+    straight out of its beams (the scans are views of them), so that a step of an env makes no scan objects
+    (about 2 µs a step for one robot); else from the latest scans. Read-only when it is a view."""
+    measured = sim.measured_beams
+    if measured is None or measured.due is not None:
+        return np.stack([sim.scans[robot][0].ranges for robot in robots])
+    if len(robots) == 1:
+        return measured.ranges[sim.beams_of(int(robots[0]))][None]
+    return np.stack([measured.ranges[sim.beams_of(int(robot))] for robot in robots])
 
 
 def goal_polar(poses: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

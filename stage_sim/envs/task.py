@@ -19,7 +19,7 @@ from types import ModuleType
 import numpy as np
 
 from stage_sim.envs.scenarios import Scenario
-from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar, layout_for
+from stage_sim.envs.spaces import ActionMap, ObservationBuilder, first_laser_ranges, goal_polar, layout_for
 from stage_sim.sim.simulation import Simulation
 
 #: Seeds handed to the simulation are drawn below this bound from the episode's generator.
@@ -155,9 +155,7 @@ def compiled_finish_step(
 ) -> StepResult:
     """:func:`finish_step` in one compiled pass: goal distance and bearing, observe, score and end episodes."""
     count = agents.size
-    scans = sim.scans
-    ranges = (scans[agents[0]][0].ranges[None] if count == 1
-              else np.stack([scans[agent][0].ranges for agent in agents]))
+    ranges = first_laser_ranges(sim, agents)
     rows = np.empty((count, observer.layout.size), dtype=np.float32)
     rewards, distance = np.empty(count), np.empty(count)
     flags = np.empty((4, count), dtype=np.bool_)

@@ -27,7 +27,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
-from stage_sim.envs.spaces import ActionMap, ObservationBuilder, goal_polar
+from stage_sim.envs.spaces import ActionMap, ObservationBuilder, first_laser_ranges, goal_polar
 from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, score, step_result
 from stage_sim.sim.simulation import SimulationBatch
 
@@ -160,7 +160,7 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         else:
             sims = [task.sim for task in self.tasks]
             poses = np.array([sim.true_poses[robot] for sim in sims])
-            ranges = np.stack([sim.scans[robot][0].ranges for sim in sims])
+            ranges = np.concatenate([first_laser_ranges(sim, np.array([robot])) for sim in sims])
             velocity = np.array([sim.velocities[robot] for sim in sims])
             stalled = np.array([sim.stalled[robot] for sim in sims])
         before = self.distance

@@ -10,7 +10,14 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from stage_sim.envs.spaces import TAIL, ActionMap, ObservationBuilder, ObservationLayout, goal_polar
+from stage_sim.envs.spaces import (
+    TAIL,
+    ActionMap,
+    ObservationBuilder,
+    ObservationLayout,
+    first_laser_ranges,
+    goal_polar,
+)
 from stage_sim.envs.task import (
     RewardConfig,
     command_agents,
@@ -18,6 +25,8 @@ from stage_sim.envs.task import (
     compiled_finish_step,
     finish_step,
 )
+from stage_sim.sim.simulation import Simulation
+from stage_sim.worldfile.loader import load_world_text
 
 AGENTS = 5
 ROBOTS = 7
@@ -80,7 +89,8 @@ def test_observations_rewards_and_ends_match_the_reference() -> None:
         velocities = rng.choice([0.0, -0.0, 0.3, 5.0, -2.0, np.nan], (7, 3))
         poses = rng.uniform(-5, 5, (7, 3))
         poses[:, 2] = rng.uniform(-4, 4, 7)
-        sim = SimpleNamespace(scans=scans, velocities=velocities, stalled=rng.random(7) < 0.2, true_poses=poses)
+        sim = SimpleNamespace(scans=scans, measured_beams=None, velocities=velocities, stalled=rng.random(7) < 0.2,
+                              true_poses=poses)
         goals = poses[agents, :2] + rng.choice([rng.uniform(-3, 3), 0.4, 0.0, 20.0], (AGENTS, 2))
         if step % 50 == 0:
             active[:] = True
@@ -109,10 +119,39 @@ def test_the_goal_bearing_an_agent_sees_is_numpys() -> None:
     bounds = np.array([[-1e9, 1e9, 0, 0, 0, 0, -1e9, 1e9]] * count)
     spaces = [layout.space(bounds[0])] * count
     observer = ObservationBuilder(layout, list(agents), spaces)
-    sim = SimpleNamespace(scans=[[SimpleNamespace(ranges=np.ones(1, dtype=np.float32))]] * count,
+    sim = SimpleNamespace(scans=[[SimpleNamespace(ranges=np.ones(1, dtype=np.float32))]] * count, measured_beams=None,
                           velocities=np.zeros((count, 3)), stalled=np.zeros(count, dtype=bool), true_poses=poses)
     result = compiled_finish_step(observer, RewardConfig(), sim, agents, goals, np.zeros(count),
                                   np.ones(count, dtype=bool), False)
     distance, bearing = goal_polar(poses, goals)
     assert same(result.distance, distance)
     assert same(result.observations[:, 2], bearing.astype(np.float32))
+
+
+def test_the_ranges_an_env_observes_are_its_robots_first_lasers_latest_scans() -> None:
+    """Read straight from the last cast's beams when it measured every ranger, from the scans when a slower
+    ranger (here robot 1's first laser) was not due: the same values either way, for any robots in any
+    order."""
+    text = """
+resolution 0.02
+interval_sim 100
+model( name "box" size [10 10 1] pose [5 5 0 0] boundary 1 )
+model( name "pillar" size [0.5 0.5 1] pose [6 4 0 0] )
+define laser ranger ( sensor( range [0 6] fov 180 samples 61 ) size [0.05 0.05 0.05] )
+define bot position ( size [0.4 0.3 0.2] drive "diff" laser( pose [0.1 0 -0.1 0] ) )
+define slow_bot position ( size [0.4 0.3 0.2] drive "diff" laser( pose [0.1 0 -0.1 0] update_interval 300 )
+                           laser( pose [-0.1 0 -0.1 180] ) )
+bot( pose [2 5 0 0] )
+slow_bot( pose [7 7 0 90] )
+bot( pose [4 2 0 45] )
+"""
+    sim = Simulation(load_world_text(text, "three.world"), seed=4, kernels="numba")
+    paths = set()
+    for step in range(9):
+        sim.set_velocity(step % 3, 0.3, 0.0, 0.2)
+        sim.step()
+        paths.add(sim.measured_beams.due is None)
+        for robots in ([0], [2, 0], [1], [1, 2, 0]):
+            expected = np.stack([sim.scans[robot][0].ranges for robot in robots])
+            assert same(first_laser_ranges(sim, np.array(robots)), expected), (step, robots)
+    assert paths == {True, False}  # both ways were read
