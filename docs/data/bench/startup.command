@@ -1,1 +1,1 @@
-python benchmarks/startup.py
+python benchmarks/startup.py --runs 1
