@@ -92,7 +92,10 @@ class Simulation:
         after this world's and they fit on its grid (an environment's reset builds one world per episode);
         else built from scratch."""
         added = self._added_static(description)
-        static = None if added is None else with_models(self.static, added, backend_for(self.kernels).trace)
+        # Traced on the kernels the new simulation starts on: not this one's, which a base world that is never
+        # stepped (an env's) keeps on numpy for good, its upgrade never adopted.
+        trace = backend_for(self._starting_kernels()).trace
+        static = None if added is None else with_models(self.static, added, trace)
         if static is None:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
@@ -115,15 +118,24 @@ class Simulation:
             return None
         return [model for _, model in added]
 
+    def _upgrade_wanted(self) -> bool:
+        """Whether a simulation of this world starts on numpy while numba loads in the background (nobody chose
+        the kernels; see sim/kernel_upgrade.py)."""
+        beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
+        return upgrade_wanted(self._kernels_asked, beams)
+
+    def _starting_kernels(self) -> str:
+        """The kernels a simulation of this world starts on."""
+        return "numpy" if self._upgrade_wanted() else resolve_kernels(self._kernels_asked)
+
     def _furnish(self, description: WorldDescription, static: StaticRaster) -> None:
         """Everything that depends on the static world: its raster, the kernels (on numpy until numba is
         loaded in the background when nobody chose, sim/kernel_upgrade.py), the contact checker, the ranger
         sensing, and the warnings about robots that start inside an obstacle."""
         self.description = description
         self.static = static
-        beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
-        self._upgrade = KernelUpgrade(self) if upgrade_wanted(self._kernels_asked, beams) else None
-        self.kernels = "numpy" if self._upgrade is not None else resolve_kernels(self._kernels_asked)
+        self.kernels = self._starting_kernels()
+        self._upgrade = KernelUpgrade(self) if self._upgrade_wanted() else None
         self._collision, self._sensing = self.build_parts(self.kernels)
         self._motion = backend_for(self.kernels).motion
         self._fused = backend_for(self.kernels).fused(self._collision, self._sensing.single_cast(), self.threads)
