@@ -93,6 +93,8 @@ class RangerSensing:
         self._slices = self._ranger_slices()
         self._scan_slots = [(robot_index, ranger.index, part)
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
+        self._beam_slices = {(robot_index, ranger_index): part for robot_index, ranger_index, part in self._scan_slots}
+        """:meth:`beams_of` of every ranger (an env reads its robots' every step)."""
         # every beam's last angle with its cos and sin (24 B a beam), which the compiled caster keeps: a robot
         # that did not turn (a stalled one) does not compute them again
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
@@ -183,10 +185,10 @@ class RangerSensing:
     def beams_of(self, robot: int, ranger: int) -> slice:
         """Where the beams of ranger ``ranger`` of robot ``robot`` lie among every ranger's
         (:attr:`~stage_sim.sim.simulation.Simulation.measured_beams`)."""
-        for robot_index, ranger_index, part in self._scan_slots:
-            if (robot_index, ranger_index) == (robot, ranger):
-                return part
-        raise IndexError(f"robot {robot} has no ranger {ranger}")
+        try:
+            return self._beam_slices[robot, ranger]
+        except KeyError:
+            raise IndexError(f"robot {robot} has no ranger {ranger}") from None
 
     def all_due(self, time: float) -> bool:
         """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
