@@ -94,8 +94,7 @@ class Simulation:
         added = self._added_static(description)
         # Traced on the kernels the new simulation starts on: not this one's, which a base world that is never
         # stepped (an env's) keeps on numpy for good, its upgrade never adopted.
-        trace = backend_for(self._starting_kernels()).trace
-        static = None if added is None else with_models(self.static, added, trace)
+        static = None if added is None else with_models(self.static, added, backend_for(self._starting_kernels()).trace)
         if static is None:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
