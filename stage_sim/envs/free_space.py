@@ -24,7 +24,6 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from stage_sim.maps.raster import StaticBody
-from stage_sim.maps.tiles import unique_sorted
 from stage_sim.sim.simulation import Simulation
 
 #: Candidates drawn per batch, and batches tried, before every valid cell is looked at.
@@ -81,33 +80,46 @@ class FreeSpace:
         static = sim.static
         same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
-        blocked, clusters = self._blocked_with(sim) if same_grid else (None, None)
-        if blocked is None or (clusters is None and (self._blocked & ~blocked).any()):
+        if not same_grid:
             return FreeSpace(sim, self._robots, self._margin)
-        if clusters is None:
+        bodies = self._added_bodies(sim)
+        lost = None
+        if bodies is None:  # not this world's bodies and more: only a grid that lost no blocked cell is redone here
+            blocked = self._blocked_of(sim)
+            if (self._blocked & ~blocked).any():
+                return FreeSpace(sim, self._robots, self._margin)
             added = blocked & ~self._blocked
-            added_cells = np.flatnonzero(added)
-            clusters = _clusters(added, added_cells)
-        else:  # only bodies added, each within its box: the grid is looked at there alone
-            added, added_cells = self._added_within(blocked, clusters)
-        valid = self._valid.copy()
-        pad = self._pad
-        if sim.kernels == "numba":
-            from stage_sim.envs.free_space_kernels import clear_near
+            boxes = _clusters(added, np.flatnonzero(added))
+            valid = self._cleared_near(added, boxes)
+        elif sim.kernels == "numba":
+            from stage_sim.envs.free_space_kernels import add_bodies
 
-            clear_near(valid, added, added_cells, self._spans)
+            blocked, valid = self._blocked.copy(), self._valid.copy()
+            lost, found = (add_bodies(blocked, valid, bodies, self._spans) if bodies
+                           else (np.zeros(0, dtype=np.int64), np.zeros((0, 4), dtype=np.int64)))
+            boxes = [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in found.tolist()]
         else:
-            for rows, cols in clusters:
-                window = (slice(max(rows.start - pad, 0), rows.stop + pad),
-                          slice(max(cols.start - pad, 0), cols.stop + pad))
-                clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
-                valid[window] &= clearance > self._reach
+            blocked, boxes = self._blocked_with(bodies)
+            valid = self._cleared_near(self._added_within(blocked, boxes), boxes)
         space = copy.copy(self)
         space.__dict__.pop("_rank", None)  # this space's, not the copy's
         space._bodies = list(static.bodies)
         space._blocked = blocked
-        space._index_near(self, valid, clusters, pad + 1, sim.kernels == "numba")
+        space._index_near(self, valid, boxes, self._pad + 1, sim.kernels == "numba", lost)
         return space
+
+    def _cleared_near(self, added: np.ndarray, boxes: list[tuple[slice, slice]]) -> np.ndarray:
+        """This space's valid centres less those within reach of the ``added`` blocked cells, all within
+        ``boxes``: a distance transform around each box (the numpy reference of
+        :func:`~stage_sim.envs.free_space_kernels.add_bodies`)."""
+        valid = self._valid.copy()
+        pad = self._pad
+        for rows, cols in boxes:
+            window = (slice(max(rows.start - pad, 0), rows.stop + pad),
+                      slice(max(cols.start - pad, 0), cols.stop + pad))
+            clearance = ndimage.distance_transform_edt(~added[window]) * self.resolution
+            valid[window] &= clearance > self._reach
+        return valid
 
     @cached_property
     def _spans(self) -> np.ndarray:
@@ -137,42 +149,38 @@ class FreeSpace:
             blocked |= sim.static.filled_collision_layer(*band)
         return blocked
 
-    def _blocked_with(self, sim: Simulation) -> tuple[np.ndarray, list[tuple[slice, slice]] | None]:
-        """:meth:`_blocked_of` ``sim`` (on this grid): this world's blocked cells and those of the bodies added
-        after this world's when its bodies come first, the very objects (an episode's world,
-        :meth:`~stage_sim.sim.simulation.Simulation.with_static_models`), else worked out anew. With the boxes
-        (rows, cols) of the added bodies that block, when it knows them (None: worked out anew)."""
+    def _added_bodies(self, sim: Simulation) -> list[StaticBody] | None:
+        """The bodies of ``sim`` after this world's that block its robots, when its bodies begin with this world's,
+        the very objects (an episode's world, :meth:`~stage_sim.sim.simulation.Simulation.with_static_models`);
+        None otherwise."""
         bodies = sim.static.bodies
         if len(bodies) < len(self._bodies) or any(a is not b for a, b in zip(self._bodies, bodies, strict=False)):
-            return self._blocked_of(sim), None
+            return None
         bands = {sim.robots[i].z_band for i in self._robots}
+        return [body for body in bodies[len(self._bodies):]
+                if body.outline.size and any(body.blocks(*band) for band in bands)]
+
+    def _blocked_with(self, bodies: list[StaticBody]) -> tuple[np.ndarray, list[tuple[slice, slice]]]:
+        """This space's blocked cells and the filled footprints of ``bodies`` (on its grid), with a box (rows, cols)
+        holding each footprint."""
         blocked = self._blocked.copy()
-        mark = _mark_filled
-        if sim.kernels == "numba":
-            from stage_sim.envs.free_space_kernels import mark_filled as mark
         boxes = []
-        for body in bodies[len(self._bodies):]:
-            if any(body.blocks(*band) for band in bands) and body.outline.size:
-                mark(blocked, body)
-                # its filled cells lie within its outline's box (a cell wider: the fill and the outline round
-                # the same vertices each its own way)
-                rows, cols = np.divmod(body.outline, self.width)
-                boxes.append((slice(max(int(rows[0]) - 1, 0), int(rows[-1]) + 2),
-                              slice(max(int(cols.min()) - 1, 0), int(cols.max()) + 2)))
+        for body in bodies:
+            blocked.ravel()[body.cells] = True
+            # its filled cells lie within its outline's box (a cell wider: the fill and the outline round the same
+            # vertices each its own way)
+            rows, cols = np.divmod(body.outline, self.width)
+            boxes.append((slice(max(int(rows[0]) - 1, 0), int(rows[-1]) + 2),
+                          slice(max(int(cols.min()) - 1, 0), int(cols.max()) + 2)))
         return blocked, boxes
 
-    def _added_within(self, blocked: np.ndarray, boxes: list[tuple[slice, slice]]) -> tuple[np.ndarray, np.ndarray]:
-        """The cells ``blocked`` holds and this space's blocked cells do not, all within ``boxes``: as a grid and
-        as sorted flat cells (what ``blocked & ~self._blocked`` and its ``flatnonzero`` give, without a pass over
-        the whole grid)."""
+    def _added_within(self, blocked: np.ndarray, boxes: list[tuple[slice, slice]]) -> np.ndarray:
+        """The cells ``blocked`` holds and this space's blocked cells do not, all within ``boxes`` (what
+        ``blocked & ~self._blocked`` gives, without a pass over the whole grid)."""
         added = np.zeros_like(blocked)
-        flat = [np.zeros(0, dtype=np.int64)]
         for rows, cols in boxes:
-            window = blocked[rows, cols] & ~self._blocked[rows, cols]
-            added[rows, cols] = window
-            local_rows, local_cols = np.nonzero(window)
-            flat.append((local_rows + rows.start) * self.width + local_cols + cols.start)
-        return added, unique_sorted(np.concatenate(flat))
+            added[rows, cols] = blocked[rows, cols] & ~self._blocked[rows, cols]
+        return added
 
     def _index(self, valid: np.ndarray, compiled: bool) -> None:
         """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
@@ -193,7 +201,7 @@ class FreeSpace:
         self._check_room()
 
     def _index_near(self, base: FreeSpace, valid: np.ndarray, boxes: list[tuple[slice, slice]], reach: int,
-                    compiled: bool) -> None:
+                    compiled: bool, lost: np.ndarray | None = None) -> None:
         """:meth:`_index` of ``valid``, which is ``base``'s valid centres less some within ``reach`` - 1 cells of
         ``boxes``, without labelling the whole grid when it can. Around the boxes, windows wider than that
         (disjoint: overlapping ones merged): if ``base`` is one region and the valid centres of every window
@@ -202,7 +210,8 @@ class FreeSpace:
         the window), and its cells are ``base``'s less those lost, looked up in ``base``'s without a copy
         (:class:`_CellIndex`). A window split in two may join around its obstacle a little farther out: the
         windows are tried :data:`WINDOW_TRIES` times, wider each time, while they cover at most
-        :data:`WINDOWS_SHARE` of the grid; then the whole grid is labelled."""
+        :data:`WINDOWS_SHARE` of the grid; then the whole grid is labelled. ``lost``: the flat cells ``base`` holds
+        and ``valid`` does not, sorted, when known (else found in the windows)."""
         windows = None
         if base._count == 1:
             for widen in range(WINDOW_TRIES):
@@ -216,11 +225,12 @@ class FreeSpace:
         if windows is None:
             self._index(valid, compiled)
             return
-        lost = [np.flatnonzero(base._valid[window] & ~valid[window]) for window in windows]
-        flat = [(rows.start + local // (cols.stop - cols.start)) * self.width + cols.start
-                + local % (cols.stop - cols.start) for (rows, cols), local in zip(windows, lost, strict=True)]
-        removed = np.sort(np.concatenate([np.zeros(0, dtype=np.int64), *flat]))
-        positions = base._rank[removed].astype(np.int64)
+        if lost is None:
+            local = [np.flatnonzero(base._valid[window] & ~valid[window]) for window in windows]
+            flat = [(rows.start + cells // (cols.stop - cols.start)) * self.width + cols.start
+                    + cells % (cols.stop - cols.start) for (rows, cols), cells in zip(windows, local, strict=True)]
+            lost = np.sort(np.concatenate([np.zeros(0, dtype=np.int64), *flat]))
+        positions = base._rank[lost].astype(np.int64)
         self._valid = valid
         self._count = 1
         self._regions = None
@@ -314,12 +324,6 @@ class FreeSpace:
         return self._cells
 
 
-def _mark_filled(blocked: np.ndarray, body: StaticBody) -> None:
-    """Set in ``blocked`` the cells of ``body``'s filled footprint (the numpy reference of
-    :func:`~stage_sim.envs.free_space_kernels.mark_filled`)."""
-    blocked.ravel()[body.cells] = True
-
-
 def _label(valid: np.ndarray, compiled: bool) -> tuple[np.ndarray, int]:
     """The 8-connected regions of ``valid`` and their count: scipy's labelling or (``compiled``) its twin."""
     if compiled:
@@ -398,16 +402,24 @@ def _clusters(mask: np.ndarray, cells: np.ndarray) -> list[tuple[slice, slice]]:
 class _Fits:
     """Which candidate points keep ``separation`` from ``avoid`` and ``min_distance`` from ``away_from``."""
 
+    #: Candidate-point pairs up to which every distance is computed at once; past it (the look at every valid
+    #: cell) a k-d tree of ``avoid`` answers. Both compute sqrt(dx² + dy²), so they agree to the bit.
+    PAIRS_AT_ONCE = 1 << 16
+
     def __init__(self, avoid: np.ndarray, separation: float, away_from: np.ndarray | None, min_distance: float):
-        self.tree = cKDTree(avoid) if len(avoid) else None
+        self.avoid = np.asarray(avoid, dtype=np.float64).reshape(-1, 2)
         self.separation = separation
         self.away_from = away_from
         self.min_distance = min_distance
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         ok = np.ones(len(points), dtype=bool)
-        if self.tree is not None:
-            nearest, _ = self.tree.query(points, distance_upper_bound=self.separation)
+        if len(self.avoid) and len(points) * len(self.avoid) <= self.PAIRS_AT_ONCE:
+            dx = np.subtract.outer(points[:, 0], self.avoid[:, 0])
+            dy = np.subtract.outer(points[:, 1], self.avoid[:, 1])
+            ok &= np.sqrt((dx * dx + dy * dy).min(axis=1)) >= self.separation
+        elif len(self.avoid):
+            nearest, _ = cKDTree(self.avoid).query(points, distance_upper_bound=self.separation)
             ok &= nearest >= self.separation
         if self.away_from is not None:
             ok &= np.linalg.norm(points - self.away_from, axis=1) >= self.min_distance

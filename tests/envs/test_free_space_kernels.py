@@ -60,10 +60,11 @@ def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float
 
 @pytest.mark.parametrize("resolution", [0.05, 0.037])
 def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> None:
-    """An episode's new bodies are marked blocked by the compiled fill (``mark_filled``): the very cells of
+    """An episode's new bodies are marked blocked by the compiled fill (``add_bodies``): the very cells of
     ``StaticBody.cells`` (outline and centres inside, even-odd), for boxes, concave and self-crossing polygons,
-    bodies of several polygons, and bodies partly off the grid."""
-    from stage_sim.envs.free_space_kernels import mark_filled
+    bodies of several polygons, and bodies partly off the grid; each body's box holds its cells, and the valid
+    centres lost are those near the cells it newly blocks, reported sorted."""
+    from stage_sim.envs.free_space_kernels import add_bodies
     from stage_sim.maps.raster import StaticBody
 
     rng = np.random.default_rng(int(resolution * 1000))
@@ -86,6 +87,16 @@ def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> N
         body = StaticBody("b", outline, (0.0, 1.0), 1.0, True, polygons, (resolution, origin, shape))
         expected = np.zeros(shape, dtype=bool)
         expected.ravel()[body.cells] = True
-        marked = np.zeros(shape, dtype=bool)
-        mark_filled(marked, body)
-        np.testing.assert_array_equal(marked, expected)
+        marked = rng.random(shape) < 0.02  # cells blocked before: not new, drawing no disk of their own
+        before = marked.copy()
+        valid = rng.random(shape) < 0.9
+        start = valid.copy()
+        spans = np.array([[-1, -1, 1], [0, -2, 2], [1, -1, 1]], dtype=np.int64)
+        reference = valid.copy()
+        clear_near(reference, expected | before, np.flatnonzero(expected & ~before), spans)
+        lost, boxes = add_bodies(marked, valid, [body], spans)
+        np.testing.assert_array_equal(marked, expected | before)
+        np.testing.assert_array_equal(valid, reference)
+        np.testing.assert_array_equal(lost, np.flatnonzero(start & ~valid))
+        rows, cols = np.nonzero(expected)
+        assert boxes.tolist() == [[rows.min(), rows.max() + 1, cols.min(), cols.max() + 1]]
