@@ -24,7 +24,7 @@ layer). The filled footprints are made only when a map is asked for.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from functools import cached_property
 from itertools import groupby
@@ -85,12 +85,21 @@ class StaticRaster:
     origin_xy: tuple[float, float]
     bodies: list[StaticBody]
     _cache: dict = field(default_factory=dict, repr=False)
+    extends: StaticRaster | None = field(default=None, repr=False, compare=False)
+    """The raster this one adds bodies to, on the same grid (:func:`with_models`): its tiles, once made, are
+    extended rather than made again."""
 
     @cached_property
     def grid(self) -> TileGrid:
         """The tile grid: Stage's regions, a slot for each one holding a block of any body at any height."""
-        blocks = np.concatenate([body.outline for body in self.bodies] or [np.zeros(0, dtype=np.int64)])
-        return TileGrid.build(self.shape, self.resolution, self.origin_xy, blocks)
+        base = self.extends
+        if base is not None and "grid" in base.__dict__:
+            return base.grid.with_blocks(self._outlines(range(len(base.bodies), len(self.bodies))))
+        return TileGrid.build(self.shape, self.resolution, self.origin_xy, self._outlines(range(len(self.bodies))))
+
+    def _outlines(self, chosen: Iterable[int]) -> np.ndarray:
+        """The outline cells of the bodies ``chosen``, end to end."""
+        return np.concatenate([self.bodies[i].outline for i in chosen] or [np.zeros(0, dtype=np.int64)])
 
     def sensing_tiles(self, height: float) -> tuple[TileLayer, CellValues]:
         """The cells rays at ``height`` hit, in tiles, and their intensity (a later body over an earlier one).
@@ -117,9 +126,14 @@ class StaticRaster:
         tiles, made once per set of bodies (layers are never written to)."""
         key = ("layer", chosen)
         if key not in self._cache:
-            if flat is None:
-                flat = np.concatenate([self.bodies[i].outline for i in chosen] or [np.zeros(0, dtype=np.int64)])
-            self._cache[key] = TileLayer.from_cells(self.grid, unique_sorted(flat))
+            base = self.extends
+            kept = tuple(i for i in chosen if base is not None and i < len(base.bodies))
+            if base is not None and ("layer", kept) in base._cache:
+                added = self._outlines(chosen[len(kept):])
+                self._cache[key] = base._cache[("layer", kept)].with_cells(self.grid, added)
+            else:
+                flat = self._outlines(chosen) if flat is None else flat
+                self._cache[key] = TileLayer.from_cells(self.grid, unique_sorted(flat))
         return self._cache[key]
 
     def sensing_layer(self, height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -227,7 +241,8 @@ def with_models(raster: StaticRaster, models: list[Model],
         return None
     frame = (raster.resolution, raster.origin_xy, raster.shape)
     bodies = [*raster.bodies, *_static_bodies(shapes, outlines, low, frame)]
-    return StaticRaster(shape=raster.shape, resolution=raster.resolution, origin_xy=raster.origin_xy, bodies=bodies)
+    return StaticRaster(shape=raster.shape, resolution=raster.resolution, origin_xy=raster.origin_xy, bodies=bodies,
+                        extends=raster)
 
 
 def _static_bodies(

@@ -70,6 +70,18 @@ class TileGrid:
         slots.ravel()[used] = np.arange(used.size, dtype=np.int32)
         return grid
 
+    def with_blocks(self, blocks: np.ndarray) -> TileGrid:
+        """This grid with more flat block cells ``blocks`` (all on it): what :meth:`build` makes of this grid's
+        blocks and those, the slots numbered alike (in region order), from the regions alone."""
+        rr, rc, _, _ = self.locate(np.asarray(blocks, dtype=np.int64))
+        held = self.slots.ravel()
+        used = np.union1d(np.flatnonzero(held >= 0), rr * self.slots.shape[1] + rc)
+        if used.size == self.slot_count:
+            return self
+        slots = np.full(self.slots.shape, -1, dtype=np.int32)
+        slots.ravel()[used] = np.arange(used.size, dtype=np.int32)
+        return TileGrid(self.shape, self.col0, self.row0, self.rcol0, self.rrow0, slots)
+
     @property
     def slot_count(self) -> int:
         return int(self.slots.max(initial=-1)) + 1
@@ -117,6 +129,23 @@ class TileLayer:
         occupied = np.zeros((used.size, TILE, TILE), dtype=bool)
         occupied[tile, ty, tx] = True
         return cls(grid, tile_of_slot, np.packbits(occupied, axis=-1, bitorder="little"))
+
+    def with_cells(self, grid: TileGrid, flat: np.ndarray) -> TileLayer:
+        """The layer of this one's cells and the flat cells ``flat`` on ``grid``, this layer's grid with more
+        blocks (:meth:`TileGrid.with_blocks`): what :meth:`from_cells` makes of them all, this layer's tiles
+        moved to their new places rather than made again."""
+        rr, rc, ty, tx = grid.locate(np.asarray(flat, dtype=np.int64))
+        slot = grid.slots[rr, rc]
+        old = np.flatnonzero(self.tile_of_slot >= 0)  # this layer's slots, in its tiles' order
+        regions = np.flatnonzero(self.grid.slots.ravel() >= 0)  # this grid's regions, in its slots' order
+        moved = grid.slots.ravel()[regions[old]]
+        used = np.union1d(moved, slot)
+        tile_of_slot = np.full(grid.slot_count, -1, dtype=np.int32)
+        tile_of_slot[used] = np.arange(used.size, dtype=np.int32)
+        bits = np.zeros((used.size, TILE, TILE // 8), dtype=np.uint8)
+        bits[tile_of_slot[moved]] = self.bits[self.tile_of_slot[old]]
+        np.bitwise_or.at(bits, (tile_of_slot[slot], ty, tx >> 3), (1 << (tx & 7)).astype(np.uint8))
+        return TileLayer(grid, tile_of_slot, bits)
 
     @property
     def occupied(self) -> np.ndarray:

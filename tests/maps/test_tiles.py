@@ -26,6 +26,53 @@ def test_a_layer_holds_exactly_its_cells_in_the_tiles_of_their_regions() -> None
     assert layer.bits.shape[0] == len(regions)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_a_grid_and_layer_extended_with_more_cells_are_those_built_from_all_of_them(seed: int) -> None:
+    """An episode's world adds bodies to its base: the base's tile grid and layers are extended
+    (``TileGrid.with_blocks``, ``TileLayer.with_cells``), slot for slot and tile for tile what building them
+    from every cell gives, also when the new cells fall in new regions, in regions already held, or in none."""
+    rng = np.random.default_rng(seed)
+    shape = (int(rng.integers(40, 400)), int(rng.integers(40, 400)))
+    base = np.unique(rng.integers(0, shape[0] * shape[1], int(rng.integers(0, 600))))
+    more = rng.integers(0, shape[0] * shape[1], int(rng.integers(0, 300)))
+    if seed == 0:
+        more = base[:5]  # no new region
+    origin = (float(rng.uniform(-5, 5)), float(rng.uniform(-5, 5)))
+    grid = TileGrid.build(shape, 0.05, origin, base)
+    extended = grid.with_blocks(more)
+    fresh = TileGrid.build(shape, 0.05, origin, np.concatenate([base, more]))
+    np.testing.assert_array_equal(extended.slots, fresh.slots)
+    assert (extended.col0, extended.row0, extended.rcol0, extended.rrow0) == (fresh.col0, fresh.row0, fresh.rcol0,
+                                                                              fresh.rrow0)
+    layer_cells = base[rng.random(base.size) < 0.5]
+    layer = TileLayer.from_cells(grid, layer_cells).with_cells(extended, more)
+    expected = TileLayer.from_cells(fresh, np.unique(np.concatenate([layer_cells, more])))
+    np.testing.assert_array_equal(layer.tile_of_slot, expected.tile_of_slot)
+    np.testing.assert_array_equal(layer.bits, expected.bits)
+
+
+def test_an_episode_world_extends_its_base_tiles_into_those_of_a_fresh_raster() -> None:
+    """``with_models`` (an episode's obstacles) extends the base raster's grid and layers: the same arrays as a
+    raster built from all the bodies."""
+    from stage_sim.maps.raster import StaticRaster, with_models
+    from stage_sim.worldfile.loader import load_world_text as load
+
+    base_text = ("resolution 0.05\nmodel( size [8 0.1 1] pose [0 -3 0 0] obstacle_return 1 )\n"
+                 "model( size [0.1 6 0.5] pose [3.9 0 0 0] obstacle_return 1 )\n")
+    base = build_static_raster(load(base_text, "base.world"))
+    base.collision_tiles(0.0, 0.4), base.sensing_tiles(0.2)  # made, as a simulation of the base world makes them
+    boxes = load(base_text + "model( size [0.6 0.4 1] pose [1 1 0 30] obstacle_return 1 )\n"
+                 "model( size [0.3 0.9 0.3] pose [-2 0.5 0 70] obstacle_return 1 )\n", "boxes.world").models[2:]
+    episode = with_models(base, boxes)
+    assert episode is not None and episode.extends is base
+    fresh = StaticRaster(episode.shape, episode.resolution, episode.origin_xy, episode.bodies)
+    np.testing.assert_array_equal(episode.grid.slots, fresh.grid.slots)
+    for extended, built in ((episode.collision_tiles(0.0, 0.4), fresh.collision_tiles(0.0, 0.4)),
+                            (episode.sensing_tiles(0.2)[0], fresh.sensing_tiles(0.2)[0])):
+        np.testing.assert_array_equal(extended.tile_of_slot, built.tile_of_slot)
+        np.testing.assert_array_equal(extended.bits, built.bits)
+
+
 def test_intensities_are_the_last_body_s_and_a_single_value_stores_no_cells() -> None:
     values = CellValues.last_wins(np.array([7, 3, 7, 9]), np.array([0.5, 1.0, 2.0, 1.0]))
     np.testing.assert_array_equal(values.at(np.array([3, 7, 9])), [1.0, 2.0, 1.0])
