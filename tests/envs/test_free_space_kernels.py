@@ -37,15 +37,21 @@ def test_spirals_and_diagonals_merge_late_as_in_scipy() -> None:
         np.testing.assert_array_equal(labels, expected)
 
 
+def _disk(reach: float, resolution: float) -> np.ndarray:
+    """The rows (row offset, first and last column offset) of the cells within ``reach`` of a cell, by the
+    distances a distance transform computes."""
+    pad = int(reach / resolution) + 1
+    rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
+    near = ~(np.sqrt((rows * rows + cols * cols).astype(np.float64)) * resolution > reach)
+    return np.array([(r, cols[i][near[i]].min(), cols[i][near[i]].max()) for i, r in enumerate(rows[:, 0])
+                     if near[i].any()], dtype=np.int64)
+
+
 @pytest.mark.parametrize("reach", [0.05, 0.349, 0.35, 0.6])
 def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float) -> None:
     rng = np.random.default_rng(int(reach * 1000))
     resolution = 0.05
-    pad = int(reach / resolution) + 1
-    rows, cols = np.mgrid[-pad:pad + 1, -pad:pad + 1]
-    near = ~(np.sqrt((rows * rows + cols * cols).astype(np.float64)) * resolution > reach)
-    spans = np.array([(r, cols[i][near[i]].min(), cols[i][near[i]].max()) for i, r in enumerate(rows[:, 0])
-                      if near[i].any()], dtype=np.int64)
+    spans = _disk(reach, resolution)
     for _ in range(30):
         added = np.zeros(tuple(rng.integers(5, 70, 2)), dtype=bool)
         for _ in range(rng.integers(1, 4)):  # solid blocks (deep inner cells), some at the grid's edge
@@ -70,7 +76,7 @@ def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> N
     rng = np.random.default_rng(int(resolution * 1000))
     shape, origin = (90, 120), (-1.013, -0.71)
     extent = np.array([shape[1], shape[0]]) * resolution
-    for _ in range(150):
+    for trial in range(150):
         polygons = []
         for _ in range(int(rng.integers(1, 3))):
             centre = np.array(origin) + rng.uniform(-0.2, 1.2, 2) * extent
@@ -89,9 +95,10 @@ def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> N
         expected.ravel()[body.cells] = True
         marked = rng.random(shape) < 0.02  # cells blocked before: not new, drawing no disk of their own
         before = marked.copy()
+        spans = _disk((0.06, 0.35, 0.61)[trial % 3], resolution)
         valid = rng.random(shape) < 0.9
+        clear_near(valid, before, np.flatnonzero(before), spans)  # a free space: nothing valid near a blocked cell
         start = valid.copy()
-        spans = np.array([[-1, -1, 1], [0, -2, 2], [1, -1, 1]], dtype=np.int64)
         reference = valid.copy()
         clear_near(reference, expected | before, np.flatnonzero(expected & ~before), spans)
         lost, boxes = add_bodies(marked, valid, [body], spans)
