@@ -12,6 +12,7 @@ becomes r + r·p·U' + G, with U, U' uniform in [−1, 1) and G normal with vari
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
@@ -88,32 +89,49 @@ class RangerSensing:
         self._ray_noise = self._noise[self._ranger_of_ray]
         self._noisy = bool(np.any(self._noise != 0.0))
         self._angle_noisy = bool(np.any(self._noise[:, 2] != 0.0))
-        ray_height = np.concatenate(heights) if heights else np.zeros(0)
-        self._groups = self._height_groups(robots, static, ray_height)
+        self._robots = robots
+        self._ray_height = np.concatenate(heights) if heights else np.zeros(0)
+        self._groups = self._height_groups(robots, static, self._ray_height)
         self._slices = self._ranger_slices()
         self._scan_slots = [(robot_index, ranger.index, part)
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
         self._beam_slices = {(robot_index, ranger_index): part for robot_index, ranger_index, part in self._scan_slots}
         """:meth:`beams_of` of every ranger (an env reads its robots' every step)."""
+        self._no_jitter = np.zeros(0)
+        self._longest_us = int(self._interval_us.max(initial=0))
+        self._shortest_us = int(self._interval_us.min(initial=0))
+        self._every_ray = np.ones(len(self._owner), dtype=bool)
+        self._start()
+
+    def over(self, static: StaticRaster, grid: GridFrame, backend: Backend,
+             raster: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> RangerSensing:
+        """These rangers over another static world (an episode's obstacles added: an env's reset), on ``backend``:
+        what a new RangerSensing of the same robots gives, the beam tables shared (they depend on the robots
+        alone), the casters made for ``static`` and everything a cast changes fresh."""
+        sensing = copy.copy(self)
+        sensing._grid, sensing._backend, sensing._raster = grid, backend, raster
+        sensing._groups = sensing._height_groups(self._robots, static, self._ray_height)
+        sensing._start()
+        return sensing
+
+    def _start(self) -> None:
+        """What casts change, as before the first: no scans, every ranger due, trigonometry and noise buffers
+        unset, a fresh generator."""
         # every beam's last angle with its cos and sin (24 B a beam), which the compiled caster keeps: a robot
         # that did not turn (a stalled one) does not compute them again
         self._trig = tuple(np.full(len(self._owner), np.nan) for _ in range(3))
-        self._no_jitter = np.zeros(0)
         self._all_cast = self._all_cast_noise()
-        self._latest: list[list[Scan]] = [[] for _ in robots]
+        self._latest: list[list[Scan]] = [[] for _ in self._robots]
         self._unpublished: tuple[np.ndarray, np.ndarray, float] | None = None
         """A fused step's cast of every ranger (float32 ranges, intensities, time) not made into scans yet."""
         self.measured: MeasuredBeams | None = None
         """The beams of the last sensing that cast any (None before the first)."""
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
-        self._longest_us = int(self._interval_us.max(initial=0))
-        self._shortest_us = int(self._interval_us.min(initial=0))
         self._all_due_us = 0
         """From this sim time on every ranger is due (the common step, told without an array per ranger)."""
         self._next_due_us = 0
         """Before this sim time no ranger is due (the steps between a slow laser's scans)."""
-        self._every_ray = np.ones(len(self._owner), dtype=bool)
         self._stale = True
 
     def reset(self, rng: np.random.Generator) -> None:

@@ -98,7 +98,7 @@ class Simulation:
         if static is None:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
-        sim._furnish(description, static)
+        sim._furnish(description, static, self._sensing)
         sim.reset(seed)
         return sim
 
@@ -127,15 +127,17 @@ class Simulation:
         """The kernels a simulation of this world starts on."""
         return "numpy" if self._upgrade_wanted() else resolve_kernels(self._kernels_asked)
 
-    def _furnish(self, description: WorldDescription, static: StaticRaster) -> None:
+    def _furnish(self, description: WorldDescription, static: StaticRaster,
+                 rangers_of: RangerSensing | None = None) -> None:
         """Everything that depends on the static world: its raster, the kernels (on numpy until numba is
         loaded in the background when nobody chose, sim/kernel_upgrade.py), the contact checker, the ranger
-        sensing, and the warnings about robots that start inside an obstacle."""
+        sensing (``rangers_of``'s rangers over this world when given: the same robots), and the warnings about
+        robots that start inside an obstacle."""
         self.description = description
         self.static = static
         self.kernels = self._starting_kernels()
         self._upgrade = KernelUpgrade(self) if self._upgrade_wanted() else None
-        self._collision, self._sensing = self.build_parts(self.kernels)
+        self._collision, self._sensing = self.build_parts(self.kernels, rangers_of)
         self._motion = backend_for(self.kernels).motion
         self._fused = backend_for(self.kernels).fused(self._collision, self._sensing.single_cast(), self.threads)
         note_kernels_running(self.kernels)
@@ -349,13 +351,15 @@ class Simulation:
 
     # -- construction helpers --------------------------------------------------------------------------
 
-    def build_parts(self, kernels: str) -> tuple[Contact, RangerSensing]:
-        """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used)."""
+    def build_parts(self, kernels: str, rangers_of: RangerSensing | None = None) -> tuple[Contact, RangerSensing]:
+        """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used);
+        ``rangers_of``: a sensing of these robots whose beam tables to share."""
         backend = backend_for(kernels)
         grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.threads)
         collision = self._make_collision_checker(backend, grid)
-        sensing = RangerSensing(self.robots, self.static, self._bodies, grid, backend, collision.raster)
-        return collision, sensing
+        if rangers_of is not None:
+            return collision, rangers_of.over(self.static, grid, backend, collision.raster)
+        return collision, RangerSensing(self.robots, self.static, self._bodies, grid, backend, collision.raster)
 
     def _make_collision_checker(self, backend: Backend, grid: GridFrame) -> Contact:
         bands = sorted({r.z_band for r in self.robots})
