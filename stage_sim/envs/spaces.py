@@ -92,6 +92,8 @@ class ObservationBuilder:
     def __init__(self, layout: ObservationLayout, agents: list[int], agent_spaces: list[spaces.Box]) -> None:
         self.layout = layout
         self.agents = np.asarray(agents, dtype=np.int64)
+        self.range_scale = np.float32(layout.range_max)
+        """The lasers' range as the compiled observation divides by it."""
         # A goal beyond the world's diagonal cannot happen; clipping the tail to the spaces is a guard.
         self.tail_low = np.array([space.low[-TAIL:] for space in agent_spaces], dtype=np.float32)
         self.tail_high = np.array([space.high[-TAIL:] for space in agent_spaces], dtype=np.float32)

@@ -80,15 +80,18 @@ def _goal_polar(pose, goal):
 
 @numba.njit(**_JIT)
 def observe_and_score(ranges, range_max, history, poses, velocities, stalled, agents, goals, tail_low, tail_high,
-                      before, active, at_limit, weights, rows, rewards, distance, flags):
-    """Per agent a: its goal's distance (into ``distance``) and bearing from its robot's pose, shift the newest
-    scan ``ranges[a]`` / ``range_max`` (clipped to [0, 1]) into ``history`` (A, k, B), write its observation
-    row into ``rows`` (the history, then distance, bearing, forward speed and turn rate clipped to the tail
-    bounds), its reward into ``rewards`` and (terminated, truncated, arrived, collided) into ``flags`` (4, A);
-    agents whose episode ends leave ``active``. ``weights``: progress, arrival, collision, time, goal
-    tolerance."""
+                      before, active, at_limit, weights):
+    """Per agent a: its goal's distance and bearing from its robot's pose, shift the newest scan ``ranges[a]`` /
+    ``range_max`` (clipped to [0, 1]) into ``history`` (A, k, B), its observation row (the history, then
+    distance, bearing, forward speed and turn rate clipped to the tail bounds), its reward and (terminated,
+    truncated, arrived, collided, was active) flags; agents whose episode ends leave ``active``. Returns the
+    rows (A, D) float32, rewards (A,), distances (A,) and flags (5, A), made here (arrays made in the kernel
+    cost less than arrays handed to it). ``weights``: progress, arrival, collision, time, goal tolerance."""
     count, depth, beams = history.shape
     scans = depth * beams
+    rows = np.empty((count, scans + 4), dtype=np.float32)
+    rewards, distance = np.empty(count), np.empty(count)
+    flags = np.empty((5, count), dtype=np.bool_)
     progress, arrival, collision, time, tolerance = weights[0], weights[1], weights[2], weights[3], weights[4]
     tail = np.empty(4, dtype=np.float32)
     for a in range(count):
@@ -113,5 +116,6 @@ def observe_and_score(ranges, range_max, history, poses, velocities, stalled, ag
         truncated = not terminated and live and at_limit
         rewards[a] = reward * (1.0 if live else 0.0)
         flags[0, a], flags[1, a] = terminated, truncated
-        flags[2, a], flags[3, a] = arrived and live, collided and live
+        flags[2, a], flags[3, a], flags[4, a] = arrived and live, collided and live, live
         active[a] = live and not (terminated or truncated)
+    return rows, rewards, distance, flags

@@ -13,7 +13,7 @@ refused (Stage's stall). Either ends its episode (terminated); the step limit tr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cache
+from functools import cache, cached_property
 from types import ModuleType
 
 import numpy as np
@@ -37,6 +37,13 @@ class RewardConfig:
     collision: float = 10.0
     time: float = 0.01
     goal_tolerance: float = 0.3
+
+    @cached_property
+    def weights(self) -> np.ndarray:
+        """The terms' weights and the tolerance as the compiled score takes them (read-only), made once."""
+        weights = np.array([self.progress, self.arrival, self.collision, self.time, self.goal_tolerance])
+        weights.flags.writeable = False
+        return weights
 
 
 @dataclass(frozen=True)
@@ -154,27 +161,10 @@ def compiled_finish_step(
     before: np.ndarray, active: np.ndarray, at_limit: bool,
 ) -> StepResult:
     """:func:`finish_step` in one compiled pass: goal distance and bearing, observe, score and end episodes."""
-    count = agents.size
-    ranges = first_laser_ranges(sim, agents)
-    rows = np.empty((count, observer.layout.size), dtype=np.float32)
-    rewards, distance = np.empty(count), np.empty(count)
-    flags = np.empty((4, count), dtype=np.bool_)
-    was_active = active.copy()
-    weights, range_max = _constants(reward, observer.layout.range_max)
-    _kernels().observe_and_score(
-        ranges, range_max, observer.history, sim.true_poses, sim.velocities, sim.stalled, agents, goals,
-        observer.tail_low, observer.tail_high, before, active, at_limit, weights, rows, rewards, distance, flags)
-    terminated, truncated, arrived, collided = flags[0], flags[1], flags[2], flags[3]  # unpacking iterates: slower
-    return StepResult(rows, rewards, terminated, truncated, arrived, collided, distance, was_active)
-
-
-@cache
-def _constants(reward: RewardConfig, range_max: float) -> tuple[np.ndarray, np.float32]:
-    """The reward's weights and tolerance and the range scale as the kernel takes them (made once per reward and
-    laser range, not per step)."""
-    weights = np.array([reward.progress, reward.arrival, reward.collision, reward.time, reward.goal_tolerance])
-    weights.flags.writeable = False
-    return weights, np.float32(range_max)
+    rows, rewards, distance, flags = _kernels().observe_and_score(
+        first_laser_ranges(sim, agents), observer.range_scale, observer.history, sim.true_poses, sim.velocities,
+        sim.stalled, agents, goals, observer.tail_low, observer.tail_high, before, active, at_limit, reward.weights)
+    return StepResult(rows, rewards, flags[0], flags[1], flags[2], flags[3], distance, flags[4])
 
 
 class NavigationTask:
