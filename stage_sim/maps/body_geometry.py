@@ -105,20 +105,20 @@ def transform_points(points: np.ndarray, pose: Pose) -> np.ndarray:
 
 
 def _calc_size(polygons: list[BodyPolygon], size: tuple[float, float, float]) -> list[BodyPolygon]:
-    """Stage's ``CalcSize``: stretch the joint bounding box to ``size`` and centre it (z: scale only)."""
+    """Stage's ``CalcSize``: stretch the joint bounding box to ``size`` and centre it (z: scale only). The box,
+    offset and scales are a handful of numbers, worked out in Python floats (the same IEEE arithmetic as numpy's,
+    without an array call each: a world of many small models, or an episode's boxes, makes this twice per model)."""
     if not polygons:
         return []
-    points = np.concatenate([p.points for p in polygons])
-    low, high = points.min(axis=0), points.max(axis=0)
+    points = polygons[0].points if len(polygons) == 1 else np.concatenate([p.points for p in polygons])
+    (low_x, low_y), (high_x, high_y) = points.min(axis=0).tolist(), points.max(axis=0).tolist()
     z_low, z_high = min(p.z[0] for p in polygons), max(p.z[1] for p in polygons)
-    extent = np.array([high[0] - low[0], high[1] - low[1], z_high - z_low])
-    extent = np.where(np.abs(extent) >= _TINY, extent, _TINY)
-    offset = low + extent[:2] / 2.0
-    scale = np.asarray(size, dtype=np.float64) / extent
-    return [
-        BodyPolygon((p.points - offset) * scale[:2], (p.z[0] * scale[2], p.z[1] * scale[2]), p.group)
-        for p in polygons
-    ]
+    extent = [e if abs(e) >= _TINY else _TINY for e in (high_x - low_x, high_y - low_y, z_high - z_low)]
+    offset = np.array([low_x + extent[0] / 2.0, low_y + extent[1] / 2.0])
+    scale = np.array([size[0] / extent[0], size[1] / extent[1]], dtype=np.float64)
+    scale_z = float(size[2]) / extent[2]
+    return [BodyPolygon((p.points - offset) * scale, (p.z[0] * scale_z, p.z[1] * scale_z), p.group)
+            for p in polygons]
 
 
 def _boundary_walls(polygons: list[BodyPolygon], size: tuple[float, float, float]) -> list[BodyPolygon]:
