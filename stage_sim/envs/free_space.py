@@ -258,7 +258,18 @@ class FreeSpace:
     def centres(self, cells: np.ndarray) -> np.ndarray:
         """World (x, y) of the centres of flat cell indices."""
         rows, cols = np.divmod(cells, self.width)
-        return self.origin + (np.stack([cols, rows], axis=-1) + 0.5) * self.resolution
+        xs, ys = self._axes
+        out = np.empty((len(cells), 2))
+        out[:, 0], out[:, 1] = xs[cols], ys[rows]
+        return out
+
+    @cached_property
+    def _axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """The x of every column's centres and the y of every row's (``origin + (index + 0.5) · resolution``):
+        a draw looks its candidates up rather than working them out."""
+        height = self._blocked.shape[0]
+        return (self.origin[0] + (np.arange(self.width) + 0.5) * self.resolution,
+                self.origin[1] + (np.arange(height) + 0.5) * self.resolution)
 
     def region_of(self, points: np.ndarray) -> np.ndarray:
         """Region label at world points (0: not a valid centre)."""

@@ -101,7 +101,9 @@ def transform_points(points: np.ndarray, pose: Pose) -> np.ndarray:
     """Points (M, 2) given in a frame at ``pose`` → world coordinates, summed in Stage's order."""
     c, s = np.cos(pose.yaw), np.sin(pose.yaw)
     x, y = points[:, 0], points[:, 1]
-    return np.stack([pose.x + x * c - y * s, pose.y + x * s + y * c], axis=1)
+    out = np.empty((len(points), 2))
+    out[:, 0], out[:, 1] = pose.x + x * c - y * s, pose.y + x * s + y * c
+    return out
 
 
 def _calc_size(polygons: list[BodyPolygon], size: tuple[float, float, float]) -> list[BodyPolygon]:
