@@ -40,7 +40,7 @@ $(VENV)/.package.stamp: $(VENV)/.tf2_msgs.stamp setup.py setup.cfg package.xml p
 	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . || { \
 	  echo "make setup: step 'stage_sim' failed: 'pip install -e .' did not work; see the error above" >&2; exit 1; }
 	@echo "[setup] compiling the numba kernels into their cache (once)"
-	@$(PY) -m stage_sim.sim.warm_up || { echo "make setup: step 'kernels' failed: see the error above" >&2; exit 1; }
+	@$(PY) -m stage_sim.envs.warm_up || { echo "make setup: step 'kernels' failed: see the error above" >&2; exit 1; }
 	@touch $@
 
 run: setup

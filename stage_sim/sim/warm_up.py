@@ -1,5 +1,6 @@
-"""``python -m stage_sim.sim.warm_up``: compile every numba kernel once into the disk cache (``make setup``
-runs it), so that the first simulation a user starts does not wait for the compiler."""
+"""``python -m stage_sim.sim.warm_up``: compile every simulation kernel once into the disk cache (``make setup``
+runs it through :mod:`stage_sim.envs.warm_up`, which adds the RL envs' kernels), so that the first simulation a
+user starts does not wait for the compiler."""
 
 from __future__ import annotations
 
