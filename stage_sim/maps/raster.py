@@ -127,9 +127,9 @@ class StaticRaster:
         key = ("layer", chosen)
         if key not in self._cache:
             base = self.extends
-            kept = tuple(i for i in chosen if base is not None and i < len(base.bodies))
+            kept = chosen if base is None else tuple(i for i in chosen if i < len(base.bodies))
             if base is not None and ("layer", kept) in base._cache:
-                added = self._outlines(chosen[len(kept):])
+                added = self._outlines(chosen[len(kept):])  # the bodies after the base's
                 self._cache[key] = base._cache[("layer", kept)].with_cells(self.grid, added)
             else:
                 flat = self._outlines(chosen) if flat is None else flat
