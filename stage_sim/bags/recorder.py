@@ -1,17 +1,15 @@
 """Record a running simulation into an MCAP bag without holding up its steps.
 
-After every step the stepping thread keeps what the step published in a :class:`StepBatch` and goes on; a
-batch of steps at a time is piped to the bag's writer process (:mod:`stage_sim.bags.writer`), which makes and
-writes the messages on another core. When the writer or the disk cannot keep up:
+After every step the stepping thread keeps what the step published in a :class:`StepBatch` (references) and goes
+on; a batch of steps at a time is copied into a slot of memory shared with the bag's writer process
+(:mod:`stage_sim.bags.slots`), which makes and writes the messages on another core and then frees the slot.
+When the writer or the disk cannot keep up, no slot is free:
 
 * a lossless recording (every run that is not paced to the wall clock: lockstep, ``--speedup 0``) waits
-  for the writer: the simulation slows down and every step is recorded. The stepping thread pipes each batch
-  itself, and the pipe's blocking write is the wait. A thread of its own would cost more than the write: it
-  takes the interpreter lock between the simulation's compiled calls, which made a one-robot step 10-40 %
-  slower;
-* a real-time recording drops the batch rather than fall behind the wall clock: a sender thread pipes the
-  batches from a bounded queue, and when the queue is full the batch's steps are counted, the count is said
-  at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
+  for the writer to free one: the simulation slows down and every step is recorded;
+* a real-time recording drops the batch rather than fall behind the wall clock: its steps are counted, the
+  count is said at exit (whose status is then non-zero) and stored in the bag's ``stage_sim`` metadata record.
+  It has slots for up to SLOTS_BYTES of batches, so it drops only when the writer falls that far behind.
 
 A write error (full disk, file size limit) stops the recording with one message on stderr; the simulation
 goes on and the file stays readable up to its last chunk.
@@ -20,12 +18,9 @@ goes on and the file stays readable up to its last chunk.
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import os
-import queue
 import subprocess
 import sys
-import threading
 import time
 from dataclasses import dataclass
 from multiprocessing.connection import Connection
@@ -34,6 +29,7 @@ from select import select as ready
 
 from stage_sim.bags.errors import BagError
 from stage_sim.bags.messages import MessageBuilder
+from stage_sim.bags.slots import FreeSlots, SharedSlots
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.topics import select, stageros_topics
 from stage_sim.bags.writer import Closed, Failed, Finish, Opened, WriterPlan, send_batch, send_finish
@@ -41,18 +37,20 @@ from stage_sim.interface.names import RobotNames
 from stage_sim.sim.simulation import Simulation
 
 BATCH_BYTES = 256 * 1024
-"""Bytes of steps sent to the writer at once (at most BATCH_STEPS steps): one message and one wake-up of the
-writer per batch instead of per step."""
+"""Bytes of steps handed to the writer at once (at most BATCH_STEPS steps): one note to the writer and one
+wake-up of it per batch instead of per step."""
 BATCH_STEPS = 64
-PIPE_BYTES = 4 * BATCH_BYTES
-"""What the pipe to the writer holds (Linux: as far as the system's pipe-max-size allows, 1 MiB by default):
-the buffer of a lossless recording, whose stepping thread waits only when it is full. Four batches, not one:
-with one, the simulation and the writer took turns (100 robots: each waited 2-4 ms a batch)."""
+LOSSLESS_SLOTS = 4
+"""Slots of a lossless recording: how many batches the simulation runs ahead of the writer before it waits.
+Four, not one: with one, the simulation and the writer took turns (100 robots: each waited 2-4 ms a batch)."""
 WAKE_S = 0.1
-"""Wall seconds a step waits at most before its batch is sent, however small: a slow (real-time) recording
-reaches the writer, and the disk, within this."""
-QUEUE_BYTES = 64 * 1024 * 1024
-"""Memory the queue of batches not yet sent may hold (ranges and intensities dominate: 8 bytes per beam)."""
+"""Wall seconds a step waits at most before its batch is handed over, however small: a slow (real-time)
+recording reaches the writer, and the disk, within this."""
+SLOTS_BYTES = 64 * 1024 * 1024
+"""Memory the slots of a real-time recording may hold (ranges and intensities dominate: 8 bytes per beam); they
+take memory only once used, and the freed ones are reused first."""
+MAX_SLOTS = 4096
+"""At most this many slots: their numbers freed and not yet read fit in the pipe that carries them back."""
 START_TIMEOUT_S = 120.0
 """How long the writer process may take to start and create the file (a cold start imports for seconds)."""
 
@@ -95,7 +93,7 @@ class BagRecorder:
         when ``with_map``) before this returns.
 
         ``speedup``: the run's; ``<= 0`` (not paced) makes the recording lossless: :meth:`record_step` waits for
-        room in the queue instead of dropping steps.
+        a free slot instead of dropping steps.
         ``topics`` restricts the recording to those names (relative ones resolved in ``namespace``).
         Raises ValueError for an unknown topic and BagError when the file cannot be written."""
         self._sim = sim
@@ -109,12 +107,22 @@ class BagRecorder:
         step_bytes = 8 * sum(r.sensor.samples for robot in sim.robots for r in robot.rangers) + 200 * len(sim.robots)
         batch_steps = max(1, min(BATCH_STEPS, BATCH_BYTES // step_bytes))
         self._pending = StepBatch.first(sim, self._messages.stepped, batch_steps)
-        plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping,
-                          self._pending.layout)
+        """The steps kept since the last hand-over, moved into a free slot's batch when handed over."""
+        layout = self._pending.layout
+        count = LOSSLESS_SLOTS if self.lossless else max(2, min(MAX_SLOTS, SLOTS_BYTES // layout.nbytes))
         try:
-            self._process, self._steps, self._reports = _start_writer()
+            slots, slots_fd = SharedSlots.create(count, layout.nbytes)
+        except OSError as exc:  # no memory, or a file size limit below the slots' size
+            raise BagError(f"cannot make the memory the steps go to the bag writer in: {exc.strerror or exc}") from None
+        self._slots = [self._pending.over(buffer) for buffer in slots.buffers]
+        plan = WriterPlan(self.path, self.topics, speedup, list(builder.static(sim)), builder.stepping, layout, count)
+        try:
+            self._process, self._steps, self._reports, freed = _start_writer(slots_fd)
         except OSError as exc:  # no processes left, or the interpreter is gone
             raise BagError(f"cannot start the bag writer process: {exc.strerror or exc}") from None
+        finally:
+            os.close(slots_fd)  # the mapping stays, and the writer has its own descriptor
+        self._free = FreeSlots(count, freed)
         opened = None
         with contextlib.suppress(OSError):  # a writer that could not start: said below
             self._steps.send(plan)
@@ -122,6 +130,7 @@ class BagRecorder:
         if not isinstance(opened, Opened) or opened.error:
             self._steps.close()  # a writer still starting reads the end of its input and exits
             self._reports.close()
+            self._free.close()
             reason = (opened.error if isinstance(opened, Opened)
                       else f"cannot write bag {self.path}: {self._writer_end()}")
             if self._process.poll() is None:
@@ -133,20 +142,10 @@ class BagRecorder:
         self.summary: BagSummary | None = None
         """What was recorded, once :meth:`close` has run."""
         self._writer_lost = False
-        """Whether the writer process went away (the sender could not pipe to it)."""
+        """Whether the writer process went away (a batch could not be handed to it)."""
         self._closed: Closed | None = None
         """The writer's last report, once it has ended (early only after a bug)."""
-        self._queue: queue.Queue[StepBatch | None] = queue.Queue(
-            maxsize=max(2, QUEUE_BYTES // (batch_steps * step_bytes)))
-        self._spare: queue.SimpleQueue[StepBatch] = queue.SimpleQueue()
-        """Batches the sender has sent, to be filled again: their memory is already mapped (a fresh 1 MiB batch
-        costs the stepping thread a page fault every 4 kB it fills)."""
         self._pending_since = 0.0
-        self._thread: threading.Thread | None = None
-        """The sender of a real-time recording (a lossless one pipes its batches from the stepping thread)."""
-        if not self.lossless:
-            self._thread = threading.Thread(target=self._send, name="bag-sender", daemon=True)
-            self._thread.start()
 
     @property
     def writer_pid(self) -> int:
@@ -156,71 +155,50 @@ class BagRecorder:
     @property
     def failed(self) -> bool:
         """Whether writing has stopped on an error (the simulation may go on; nothing more is recorded). Cheap
-        enough for every step: only flags, which the writer's reports set as a batch is piped (a system call
+        enough for every step: only flags, which the writer's reports set as a batch is handed over (a system call
         per step here cost as much as keeping the step)."""
         return self.error is not None or self._writer_lost or self._closed is not None
 
     def record_step(self) -> None:
         """Keep what the step just taken published; every batch's worth (or WAKE_S), hand it to the writer: a
-        lossless recording waits for room, a real-time one drops the batch when its queue is full."""
+        lossless recording waits for a free slot, a real-time one drops the batch when there is none."""
         if self.error is not None:
             return
         now = time.monotonic()
         if not self._pending.count:
             self._pending_since = now
-        self._pending.capture(self._sim)
-        if self._pending.full or now - self._pending_since >= WAKE_S:
+        if self._pending.capture(self._sim) or now - self._pending_since >= WAKE_S:
             self._hand_over(wait=self.lossless)
 
     def _hand_over(self, wait: bool) -> None:
-        """Pipe the pending steps to the writer (lossless), or queue them for the sender; when the queue is full,
-        wait for room if ``wait``, else drop them."""
-        if self._thread is None:
-            if not self.failed:
-                self._pipe(self._pending)
-            self._pending.clear()
+        """Copy the pending steps into a free slot and tell the writer; when none is free, wait for the writer to
+        free one if ``wait``, else drop the steps."""
+        pending = self._pending
+        if self.failed:  # nothing more is recorded: close() says why
+            pending.clear()
             return
-        batch, self._pending = self._pending, self._empty_batch()
-        if self.failed:
+        slot = self._free.take(wait)
+        if slot is None:
+            if self._free.writer_gone:
+                self._writer_lost = True
+            else:
+                self.dropped_steps += pending.count
+                self.dropped_messages += self._messages.publications(pending)
+            pending.clear()
             return
-        # Here, not in the sender thread: there it would hold the interpreter lock while the stepping thread
-        # waits for it after each compiled call (as much time lost as the copies take).
-        batch.settle()
+        batch = self._slots[slot]
+        batch.take_steps(pending)
         try:
-            self._queue.put_nowait(batch)
-        except queue.Full:
-            if not (wait and self._wait_for_room(batch)):
-                self.dropped_steps += batch.count
-                self.dropped_messages += self._messages.publications(batch)
-                self._spare.put(batch)
-
-    def _empty_batch(self) -> StepBatch:
-        """A batch to fill: a spare one, else a new one."""
-        try:
-            batch = self._spare.get_nowait()
-        except queue.Empty:
-            return self._pending.empty()
-        batch.clear()
-        return batch
-
-    def _wait_for_room(self, batch: StepBatch) -> bool:
-        """Queue ``batch`` once the writer has made room; False if the recording stopped meanwhile."""
-        while self._thread is not None and self._thread.is_alive() and not self.failed:
-            try:
-                self._queue.put(batch, timeout=WAKE_S)
-                return True
-            except queue.Full:
-                pass
-        return False
+            send_batch(self._steps, slot, batch)
+        except OSError:
+            self._writer_lost = True
+        self._read_reports()
 
     def close(self) -> BagSummary:
         """Send what is pending, let the writer write the summary and wait for it: the file is complete. Safe
         to call once, also after errors; re-raises (as RuntimeError) a bug that crashed the writer."""
         if self._pending.count:
             self._hand_over(wait=True)  # nothing is paced any more: the last steps are never dropped
-        if self._thread is not None:
-            self._queue.put(None)
-            self._thread.join()
         if not self._writer_lost:
             try:
                 send_finish(self._steps, Finish({"dropped_steps": str(self.dropped_steps),
@@ -231,6 +209,7 @@ class BagRecorder:
         while self._closed is None and (report := self._next_report(None)) is not None:
             self._take(report)
         self._reports.close()
+        self._free.close()
         self._process.wait()
         messages = 0
         if self._closed is not None:
@@ -241,23 +220,6 @@ class BagRecorder:
             self.error = f"the bag writer process ended before the bag was complete ({self._writer_end()})"
         self.summary = BagSummary(self.path, messages, self.dropped_steps, self.dropped_messages, self.error)
         return self.summary
-
-    def _send(self) -> None:
-        """The sender thread: pipe each queued batch to the writer (its buffer, off the stepping thread), until
-        the closing None; if the writer has gone, the batches are dropped (close says why)."""
-        while (batch := self._queue.get()) is not None:
-            self._pipe(batch)
-            self._spare.put(batch)
-
-    def _pipe(self, batch: StepBatch) -> None:
-        """Send ``batch`` to the writer (waiting while the pipe is full), then take the reports that have come;
-        if the writer has gone, the batch is dropped (close says why)."""
-        if not self._writer_lost:
-            try:
-                send_batch(self._steps, batch)
-            except OSError:
-                self._writer_lost = True
-        self._read_reports()
 
     def _next_report(self, timeout: float | None) -> Opened | Failed | Closed | None:
         """The writer's next report, None if it ended (or ``timeout`` passed) without one."""
@@ -271,7 +233,7 @@ class BagRecorder:
             return None
 
     def _read_reports(self) -> None:
-        """Take the reports that have come, without waiting (once per batch piped: hence select, not
+        """Take the reports that have come, without waiting (once per batch handed over: hence select, not
         Connection.poll, which builds a selector per call)."""
         while not self._reports.closed and ready([self._reports], [], [], 0)[0]:
             try:
@@ -303,24 +265,23 @@ the working directory at the head of the path, where another checkout of stage_s
 then read this one's plan with other code)."""
 
 
-def _widen(pipe: int) -> None:
-    """Let the steps pipe hold PIPE_BYTES, so that sending a batch wakes the writer once, not once per 64 kB of
-    the default pipe, and the simulation runs a few batches ahead of the writer."""
-    with contextlib.suppress(AttributeError, OSError):  # not Linux, or a lower limit: the default pipe works
-        fcntl.fcntl(pipe, fcntl.F_SETPIPE_SZ, PIPE_BYTES)
-
-
-def _start_writer() -> tuple[subprocess.Popen, Connection, Connection]:
-    """Start the writer process (:mod:`stage_sim.bags.writer`) with a pipe for steps and one for its reports;
-    the writer holds the only reading end of the first, so a killed simulation ends its input."""
+def _start_writer(slots: int) -> tuple[subprocess.Popen, Connection, Connection, int]:
+    """Start the writer process (:mod:`stage_sim.bags.writer`) on the shared ``slots``, with a pipe for steps, one
+    for its reports and one for the slots it frees (whose reading end is returned); the writer holds the only
+    reading end of the first, so a killed simulation ends its input."""
     steps_in, steps_out = os.pipe()
     reports_in, reports_out = os.pipe()
-    _widen(steps_out)
+    freed_in, freed_out = os.pipe()
     root = str(Path(__file__).resolve().parents[2])  # where this stage_sim is, however the caller found it
+    ends = (steps_in, reports_out, slots, freed_out)
     try:
-        process = subprocess.Popen([sys.executable, "-c", WRITER_MAIN, root, str(steps_in), str(reports_out)],
-                                   pass_fds=(steps_in, reports_out), stdin=subprocess.DEVNULL)
+        process = subprocess.Popen([sys.executable, "-c", WRITER_MAIN, root, *map(str, ends)],
+                                   pass_fds=ends, stdin=subprocess.DEVNULL)
+    except OSError:
+        for fd in (steps_out, reports_in, freed_in):
+            os.close(fd)
+        raise
     finally:
-        os.close(steps_in)
-        os.close(reports_out)
-    return process, Connection(steps_out, readable=False), Connection(reports_in, writable=False)
+        for fd in (steps_in, reports_out, freed_out):
+            os.close(fd)
+    return process, Connection(steps_out, readable=False), Connection(reports_in, writable=False), freed_in

@@ -1,16 +1,14 @@
-"""What steps published, copied off the simulation: what the stepping side sends the bag writer process.
+"""What steps published, copied off the simulation: what the stepping side hands the bag writer process.
 
 The stepping side keeps each step's quantities (:class:`~stage_sim.interface.topics.Quantity`) in a
 :class:`StepBatch` by reference, one attribute lookup a step. The simulation never writes an array it has
 exposed (it replaces it), so the references still hold the step's values when the batch is handed over
 (:meth:`StepBatch.settle`): each quantity's steps are then copied into its column in one C call (one
-preallocated array per quantity, a row per step). About 3 µs a step in all, against 6 µs when each step was
-copied row by row (a one-robot step is about 45 µs). The batch is sent whole: all of its columns are views of
-one contiguous buffer laid out the same way in every batch of a recording (:class:`BatchLayout`, which the
-writer learns once), so a batch travels as that buffer, with no pickling (a step's values pickled one by one
-cost about as much as simulating a one-robot step; a batch's objects pickled, a few hundred µs of the sender
-holding the interpreter lock). The writer derives each topic's values for all the batch's steps at once
-(:meth:`StepBatch.values`).
+preallocated array per quantity, a row per step), about 1 µs a step in all. All of a batch's columns are views
+of one buffer, laid out the same way in every batch of a recording (:class:`BatchLayout`, which the writer learns
+once): the buffer is a slot of memory the writer process shares (:mod:`stage_sim.bags.slots`), which reads the
+steps where they were copied, with no pickling and no pipe to carry them. The writer derives each topic's values
+for all the batch's steps at once (:meth:`StepBatch.values`).
 """
 
 from __future__ import annotations
@@ -122,7 +120,7 @@ class _Array(_Column):
         if rows.ndim == 1:  # numbers
             rows[:] = kept
         else:  # arrays of one shape, end to end
-            np.concatenate(kept, out=rows.reshape(-1, *rows.shape[2:]))
+            _copy_rows(kept, rows)
 
     def rows(self, count: int) -> np.ndarray:
         return self.data[:count]
@@ -154,8 +152,8 @@ class _Scans(_Column):
         end = start + len(kept)
         if all(beams is not None and beams.time == time and beams.due is None
                for beams, time in zip(kept, seconds, strict=True)):  # every ranger measured in every step
-            np.concatenate([beams.ranges for beams in kept], out=self.ranges[start:end].reshape(-1))
-            np.concatenate([beams.intensities for beams in kept], out=self.intensities[start:end].reshape(-1))
+            _copy_rows([beams.ranges for beams in kept], self.ranges[start:end])
+            _copy_rows([beams.intensities for beams in kept], self.intensities[start:end])
             self.measured[start:end] = True
             return
         for k, beams, time in zip(range(start, end), kept, seconds, strict=True):
@@ -179,6 +177,13 @@ class _Scans(_Column):
                         self.measured[:count])
 
 
+def _copy_rows(arrays: Sequence[np.ndarray], rows: np.ndarray) -> None:
+    """Copy ``arrays``, one per row of ``rows`` and each of its dtype and row shape, into ``rows``: their bytes end
+    to end, joined by one C call (np.concatenate checked and converted each small array, four times as long).
+    An array of another size fails (the byte counts differ); the simulation's arrays keep their dtypes."""
+    memoryview(rows).cast("B")[:] = b"".join(arrays)
+
+
 def _column(value: Any, sim: Simulation) -> _Column:
     """The column for a quantity's values, shaped after one step's ``value``."""
     if isinstance(value, fields.LatestScans):
@@ -195,17 +200,11 @@ def _step_values(topic: Topic) -> StepValues:
     return topic.values
 
 
-HEAD = np.dtype(np.int64)
-"""The head of a batch's buffer: the number of steps it holds (none: the end of the batches, see
-:mod:`stage_sim.bags.writer`)."""
-
-
 @dataclass(frozen=True)
 class BatchLayout:
-    """Where a batch's columns are in its one buffer, after the step count: fixed when a recording makes its first
-    batch, the same for all its batches, and sent to the writer once. A batch then travels as its buffer
-    alone, which the writer receives into a batch of its own, whose columns are already views of it: no
-    pickling per batch (it held the sender, and the interpreter lock, longer than the buffer's trip)."""
+    """Where a batch's columns are in its one buffer: fixed when a recording makes its first batch, the same for
+    all its batches, and sent to the writer once. The writer's batches are views of the same slots laid out the
+    same way: nothing to pickle or rebuild per batch."""
 
     size: int
     """Steps (rows) a batch has room for."""
@@ -220,7 +219,7 @@ class BatchLayout:
     @classmethod
     def of(cls, columns: Sequence[_Column], uses: Sequence[tuple[Topic, tuple[int, ...]]], size: int) -> BatchLayout:
         """The columns' arrays end to end, each at a multiple of 8 bytes."""
-        at, offsets = HEAD.itemsize, []
+        at, offsets = 0, []
         for column in columns:
             starts = []
             for array in column.arrays():
@@ -236,9 +235,11 @@ class StepBatch:
     time, which also times the steps) is kept once a step, and each topic's values are derived for all the
     steps at once where they are read (:meth:`values`, in the writer process)."""
 
-    def __init__(self, layout: BatchLayout, quantities: tuple[Quantity, ...] = ()) -> None:
-        """``quantities``: what :meth:`capture` keeps for each column; none for the writer's batch, which is
-        only received into."""
+    def __init__(self, layout: BatchLayout, quantities: tuple[Quantity, ...] = (),
+                 buffer: np.ndarray | None = None) -> None:
+        """``quantities``: what :meth:`capture` keeps for each column; none for the writer's batches, which only
+        read. ``buffer``: the bytes the columns are views of (a shared slot), ``layout.nbytes`` of them; by
+        default the batch's own."""
         self.layout = layout
         self._quantities = quantities
         names = [quantity.kept for quantity in quantities]
@@ -247,9 +248,8 @@ class StepBatch:
         self._kept: list[Any] = []
         """What :meth:`capture` kept of the steps not yet in the columns: a tuple per step (one value per
         quantity), or the one value when there is one quantity."""
-        self.buffer = np.empty(layout.nbytes, np.uint8)
-        """Everything the batch holds: the step count (:meth:`packed`), then every column's arrays."""
-        self._head = self.buffer[:HEAD.itemsize].view(HEAD)
+        self.buffer = np.empty(layout.nbytes, np.uint8) if buffer is None else buffer
+        """Everything the batch holds: every column's arrays."""
         self._columns = [
             column.on([np.ndarray((layout.size, *array.shape[1:]), array.dtype, self.buffer, offset)
                        for array, offset in zip(column.arrays(), offsets, strict=True)])
@@ -266,12 +266,21 @@ class StepBatch:
         columns = [_column(quantity.read(sim), sim) for quantity in quantities]
         return cls(BatchLayout.of(columns, uses, size), tuple(quantities))
 
-    def empty(self) -> StepBatch:
-        """An empty batch like this one (the stepping side starts one as it hands the last over)."""
-        return StepBatch(self.layout, self._quantities)
+    def over(self, buffer: np.ndarray) -> StepBatch:
+        """An empty batch like this one, whose columns are views of ``buffer`` (a slot the writer shares)."""
+        return StepBatch(self.layout, self._quantities, buffer)
+
+    def take_steps(self, other: StepBatch) -> None:
+        """Hold the steps ``other`` holds, which is left empty: the steps kept by reference move, not their values,
+        so ``other`` must not be settled (the stepping side keeps steps in a batch of its own, then moves them
+        into the slot it hands over)."""
+        if other.count != len(other._kept):
+            raise ValueError("the batch's steps are already copied into its own buffer")
+        self._kept, other._kept = other._kept, []
+        self.count, other.count = other.count, 0
 
     def clear(self) -> None:
-        """Empty this batch to fill it again (its buffer is kept: the sender has sent its contents)."""
+        """Empty this batch to fill it again (its buffer is kept)."""
         self.count = 0
         self._kept.clear()
 
@@ -279,10 +288,12 @@ class StepBatch:
     def full(self) -> bool:
         return self.count == self.layout.size
 
-    def capture(self, sim: Simulation) -> None:
-        """Keep the step just taken: the quantities of the topics the batch was made for."""
+    def capture(self, sim: Simulation) -> bool:
+        """Keep the step just taken: the quantities of the topics the batch was made for. Whether the batch is
+        now full."""
         self._kept.append(self._keep(sim))
         self.count += 1
+        return self.count == self.layout.size
 
     def settle(self) -> None:
         """Copy the steps kept into the columns, each quantity's in one call (what the batch sends, the values it
@@ -295,17 +306,6 @@ class StepBatch:
         for column, values in zip(self._columns, by_quantity, strict=True):
             column.pack(values, seconds, start)
         self._kept = []
-
-    def packed(self) -> np.ndarray:
-        """The batch as it travels: its whole buffer, the step count in its head (rows past the count hold
-        earlier steps or nothing: the receiver reads ``count`` rows)."""
-        self.settle()
-        self._head[0] = self.count
-        return self.buffer
-
-    def unpack(self) -> None:
-        """Take the step count from the buffer, just received into (:meth:`packed`'s)."""
-        self.count = int(self._head[0])
 
     @property
     def times(self) -> np.ndarray:

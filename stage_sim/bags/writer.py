@@ -3,20 +3,21 @@
 Why a process and not a thread: refilling and writing a 100-robot step (400 messages) costs about as much CPU
 as simulating it, and a thread shares the simulation's GIL (recording then cost half the simulation rate). In a
 process of its own it runs on another core, and the stepping side only copies each step
-(:class:`~stage_sim.bags.step_state.StepBatch`) and sends batches of steps through a pipe.
+(:class:`~stage_sim.bags.step_state.StepBatch`) into memory both share (:mod:`stage_sim.bags.slots`).
 
-The process runs :func:`main` with ``STEPS REPORTS`` (:data:`stage_sim.bags.recorder.WRITER_MAIN`): a fresh
-interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would re-run
-the user's main script. STEPS and REPORTS are its two pipes' file descriptors, framed by
-:mod:`multiprocessing.connection`: reports and the plan are pickled, a batch of steps is sent as its buffer
-alone (:func:`send_batch`), laid out as the plan said (:class:`~stage_sim.bags.step_state.BatchLayout`). It first
-reads a :class:`WriterPlan` from the steps pipe and answers on the reports pipe with :class:`Opened` once the
-file is created and the latched messages are on disk, :class:`Failed` when the disk refuses a write (it then
-reads and discards what comes, so the simulation is never blocked by a dead recording), and :class:`Closed` at
-the end. It reads batches of steps until :class:`Finish`, or until the pipe ends without one (the simulation was
-killed): it then still writes the summary, so a kill -9 of the simulator leaves a complete bag of every step
-it had sent. It ignores SIGINT and SIGTERM: Ctrl-C in a terminal reaches the whole process group, and the
-simulation's own handler closes the recording in order.
+The process runs :func:`main` with ``STEPS REPORTS SLOTS FREED`` (:data:`stage_sim.bags.recorder.WRITER_MAIN`):
+a fresh interpreter, not a fork of a process that may run threads, and not multiprocessing's spawn, which would
+re-run the user's main script. STEPS and REPORTS are two pipes' file descriptors, framed by
+:mod:`multiprocessing.connection` (the plan and the reports are pickled); SLOTS is the shared slots' file, laid
+out as the plan says (:class:`~stage_sim.bags.step_state.BatchLayout`); FREED a pipe on which the writer gives
+back each slot once its steps are written. It first reads a :class:`WriterPlan` from the steps pipe and answers
+on the reports pipe with :class:`Opened` once the file is created and the latched messages are on disk,
+:class:`Failed` when the disk refuses a write (it then frees the slots it is told of unwritten, so the
+simulation is never blocked by a dead recording), and :class:`Closed` at the end. Each batch sent is a note
+of its slot and step count (:func:`send_batch`). It reads them until :class:`Finish`, or until the pipe ends
+without one (the simulation was killed): it then still writes the summary, so a kill -9 of the simulator leaves
+a complete bag of every step it had sent. It ignores SIGINT and SIGTERM: Ctrl-C in a terminal reaches the whole
+process group, and the simulation's own handler closes the recording in order.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import struct
 import sys
 import traceback
 from collections.abc import Sequence
@@ -33,8 +35,9 @@ from pathlib import Path
 
 from stage_sim.bags.container import McapBag
 from stage_sim.bags.errors import BagError
+from stage_sim.bags.slots import SharedSlots, free
 from stage_sim.bags.step_messages import StepMessages
-from stage_sim.bags.step_state import HEAD, BatchLayout, StepBatch
+from stage_sim.bags.step_state import BatchLayout, StepBatch
 from stage_sim.bags.topics import Topic
 
 
@@ -50,33 +53,38 @@ class WriterPlan:
     """The latched messages, serialised (/tf_static, /map)."""
     messages: StepMessages
     batches: BatchLayout
-    """How every batch sent is laid out: the writer receives each into a batch of this layout."""
+    """How every batch sent is laid out in its slot."""
+    slots: int
+    """How many slots of ``batches.nbytes`` the shared file holds."""
 
 
-def send_batch(steps: Connection, batch: StepBatch) -> None:
-    """Send ``batch`` as one message, its buffer: the pipe's write takes it from the batch's memory and drops
-    the interpreter lock meanwhile (raises OSError when the writer is gone)."""
-    steps.send_bytes(batch.packed())
+NOTE = struct.Struct("<qq")
+"""What says a batch is sent: its slot, and how many steps it holds (none: the end of the batches)."""
+
+
+def send_batch(steps: Connection, slot: int, batch: StepBatch) -> None:
+    """Send ``batch``, a view of shared slot ``slot``: copy the steps it keeps into the slot, then tell the writer
+    (raises OSError when the writer is gone). The slot is the writer's until it frees it."""
+    batch.settle()
+    steps.send_bytes(NOTE.pack(slot, batch.count))
 
 
 def send_finish(steps: Connection, finish: Finish) -> None:
-    """End the batches (a head of no steps, which no batch sent has) and send ``finish``."""
-    steps.send_bytes(bytes(HEAD.itemsize))
+    """End the batches (a note of no steps, which no batch sent has) and send ``finish``."""
+    steps.send_bytes(NOTE.pack(-1, 0))
     steps.send(finish)
 
 
-def receive_batch(steps: Connection, batch: StepBatch) -> Finish | None:
-    """Receive the next batch into ``batch``, whose columns are views of its buffer: nothing to unpickle or
-    rebuild. At the end of the batches, the :class:`Finish` that follows. Raises EOFError or OSError when the
-    sender ended first, maybe in the middle of a batch (Connection reads a whole message before it copies it
-    into the buffer: a batch cut short leaves nothing of itself)."""
-    size = steps.recv_bytes_into(batch.buffer)
-    batch.unpack()
-    if not batch.count:
+def receive_batch(steps: Connection, batches: list[StepBatch]) -> int | Finish:
+    """The slot of the next batch sent, whose batch in ``batches`` (one per slot, its columns views of it: nothing
+    to unpickle or rebuild) now holds its steps; at the end of the batches, the :class:`Finish` that follows.
+    Raises EOFError or OSError when the sender ended first, maybe in the middle of a note (Connection reads a
+    whole message before it returns it: a note cut short leaves nothing of itself)."""
+    slot, count = NOTE.unpack(steps.recv_bytes(NOTE.size))
+    if not count:
         return steps.recv()
-    if size != batch.buffer.nbytes:  # a bug: the sender's batches are laid out otherwise
-        raise ValueError(f"a batch of {size} bytes came, one of {batch.buffer.nbytes} was expected")
-    return None
+    batches[slot].count = count
+    return slot
 
 
 @dataclass(frozen=True)
@@ -141,7 +149,7 @@ class _Writer:
 
 
 def main(argv: list[str]) -> None:
-    """The process: ``STEPS REPORTS`` are the file descriptors of its two pipes."""
+    """The process: ``STEPS REPORTS SLOTS FREED`` are the file descriptors of its pipes and shared slots."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     steps, reports = Connection(int(argv[0]), writable=False), Connection(int(argv[1]), readable=False)
@@ -149,7 +157,9 @@ def main(argv: list[str]) -> None:
         plan = steps.recv()
     except (EOFError, OSError):  # the simulation ended before it sent the plan
         return
-    write_bag(plan, steps, reports)
+    slots = SharedSlots(int(argv[2]), plan.slots, plan.batches.nbytes)
+    os.close(int(argv[2]))
+    write_bag(plan, steps, reports, slots, int(argv[3]))
     # The bag is closed and reported: end without the interpreter's teardown (of numpy, foxglove, ...), which
     # took 50-80 ms that the simulation's close() waited for, as long as recording 6,000 steps of one robot.
     sys.stderr.flush()
@@ -162,8 +172,9 @@ def _report(reports: Connection, report: Opened | Failed | Closed) -> None:
         reports.send(report)
 
 
-def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
-    """Open the bag, write the latched messages, then every step sent, then the summary."""
+def write_bag(plan: WriterPlan, steps: Connection, reports: Connection, slots: SharedSlots, freed: int) -> None:
+    """Open the bag, write the latched messages, then every step sent (from ``slots``, each freed on ``freed``
+    once written), then the summary."""
     try:
         bag = McapBag(plan.path, plan.topics, plan.speedup)
     except BagError as exc:
@@ -180,7 +191,8 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
             _report(reports, Opened(f"cannot write bag {plan.path}: {exc.strerror or exc}"))
             return
         _report(reports, Opened(None))
-        metadata = _write_steps(writer, steps, StepBatch(plan.batches))
+        batches = [StepBatch(plan.batches, buffer=buffer) for buffer in slots.buffers]
+        metadata = _write_steps(writer, steps, batches, freed)
         if writer.error is None:
             try:
                 bag.finish(metadata)
@@ -192,15 +204,17 @@ def write_bag(plan: WriterPlan, steps: Connection, reports: Connection) -> None:
         _report(reports, Closed(writer.count, traceback.format_exc()))
 
 
-def _write_steps(writer: _Writer, steps: Connection, batch: StepBatch) -> dict[str, str]:
-    """Write what comes, received into ``batch`` each time, until :class:`Finish` (its metadata) or the end of the
-    pipe (the sender was killed)."""
+def _write_steps(writer: _Writer, steps: Connection, batches: list[StepBatch], freed: int) -> dict[str, str]:
+    """Write the batches sent, each one of ``batches``, freeing its slot on ``freed`` once written, until
+    :class:`Finish` (its metadata) or the end of the pipe (the sender was killed)."""
     while True:
         try:
-            finish = receive_batch(steps, batch)
-        except (EOFError, OSError):  # OSError: the sender was killed in the middle of a batch
+            slot = receive_batch(steps, batches)
+        except (EOFError, OSError):  # OSError: the sender was killed in the middle of a note
             stopped = "its start" if writer.last_us is None else f"sim time {writer.last_us / 1e6:g} s"
             return {"interrupted": f"the simulation ended without closing the bag after {stopped}"}
-        if finish is not None:
-            return finish.metadata
-        writer.steps(batch)
+        if isinstance(slot, Finish):
+            return slot.metadata
+        writer.steps(batches[slot])
+        with contextlib.suppress(BrokenPipeError):  # the simulation has gone: what it sent is still written
+            free(freed, slot)

@@ -208,8 +208,8 @@ def writer_paused(pid: int, seconds: float) -> Iterator[None]:
 
 
 def small_queue(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The smallest queue: two batches of one step (the pipe to the writer holds some 40 more)."""
-    monkeypatch.setattr("stage_sim.bags.recorder.QUEUE_BYTES", 0)
+    """Batches of one step, a real-time recording in the fewest slots (two); a lossless one has four."""
+    monkeypatch.setattr("stage_sim.bags.recorder.SLOTS_BYTES", 0)
     monkeypatch.setattr("stage_sim.bags.recorder.BATCH_STEPS", 1)
 
 

@@ -213,11 +213,22 @@ def test_a_bag_that_cannot_be_created_is_an_error_before_the_run(tmp_path) -> No
         assert "Traceback" not in result.stderr
 
 
+def test_a_file_size_limit_below_the_writer_s_shared_memory_is_an_error_before_the_run(tmp_path) -> None:
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (10_000, 10_000))
+
+    result = stage_sim("run", two_robot_world(tmp_path), "--duration", "1", "--bag", tmp_path / "x.mcap",
+                       preexec_fn=small_files)
+    assert result.returncode == 2
+    assert "cannot make the memory the steps go to the bag writer in: File too large" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
 def test_a_disk_that_fills_during_the_run_stops_it_with_a_message(tmp_path) -> None:
     bag_path = tmp_path / "filled.mcap"
 
-    def limit_file_size() -> None:  # the disk "fills" at 60 kB: after a chunk or two (zstd), the next cannot be written
-        resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
+    def limit_file_size() -> None:  # the disk "fills" at 1 MB (above the shared slots' size): after some chunks
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1_000_000, 1_000_000))
 
     result = stage_sim("run", two_robot_world(tmp_path), "--duration", "100000", "--speedup", "0", "--bag", bag_path,
                        preexec_fn=limit_file_size)

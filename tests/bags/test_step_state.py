@@ -1,16 +1,17 @@
-"""A batch of steps, sent as it travels to the bag writer (its buffer through a pipe, into the writer's batch of
-the same layout), gives back every step's values as the simulation had them: poses, times and which rangers
-measured what (rangers at different rates, a robot without any)."""
+"""A batch of steps, sent as it travels to the bag writer (copied into a shared slot, which the writer maps on
+its own, and noted through a pipe), gives back every step's values as the simulation had them: poses, times and
+which rangers measured what (rangers at different rates, a robot without any)."""
 
 from __future__ import annotations
 
+import os
 import pickle
-import threading
 from multiprocessing import Pipe
 
 import numpy as np
 import pytest
 
+from stage_sim.bags.slots import SharedSlots
 from stage_sim.bags.step_state import StepBatch
 from stage_sim.bags.writer import receive_batch, send_batch
 from stage_sim.interface import topics
@@ -34,34 +35,50 @@ bot( pose [6.0 4.0 0 0] slow( pose [0.2 0 -0.1 0] ) )
 STEPPED = [t for t in topics.PUBLISHED if t.timing is not topics.Timing.START]
 
 
-def travelled(batch: StepBatch, into: StepBatch | None = None) -> StepBatch:
-    """``batch`` as the writer gets it: sent through a pipe (by a thread: the pipe holds less than a batch) and
-    received ``into`` a batch of the layout the writer's plan brings (pickled), or a batch it received before."""
-    received = StepBatch(pickle.loads(pickle.dumps(batch.layout))) if into is None else into
-    receiving, sending = Pipe(duplex=False)
-    sender = threading.Thread(target=send_batch, args=(sending, batch))
-    sender.start()
-    assert receive_batch(receiving, received) is None
-    sender.join()
-    return received
+class Trip:
+    """The way from the stepping side to the writer: two slots, mapped once by each side, and the pipe of notes.
+    The writer's batches are of the layout its plan brings (pickled)."""
+
+    def __init__(self, batch: StepBatch) -> None:
+        size = batch.layout.nbytes
+        ours, fd = SharedSlots.create(2, size)
+        try:
+            theirs = SharedSlots(fd, 2, size)
+        finally:
+            os.close(fd)
+        self.sending = [batch.over(buffer) for buffer in ours.buffers]
+        layout = pickle.loads(pickle.dumps(batch.layout))
+        self.received = [StepBatch(layout, buffer=buffer) for buffer in theirs.buffers]
+        self.receiving, self.notes = Pipe(duplex=False)
+
+    def travel(self, batch: StepBatch, slot: int = 0) -> StepBatch:
+        """``batch``'s steps as the writer gets them through ``slot``; ``batch`` is left empty."""
+        self.sending[slot].take_steps(batch)
+        send_batch(self.notes, slot, self.sending[slot])
+        assert receive_batch(self.receiving, self.received) == slot
+        return self.received[slot]
+
+
+def travelled(batch: StepBatch) -> StepBatch:
+    """``batch`` as the writer gets it."""
+    return Trip(batch).travel(batch)
 
 
 @pytest.mark.parametrize("refilled", [False, True])
 def test_a_sent_batch_gives_back_every_step(tmp_path, refilled) -> None:
-    """Also a batch not full (a hand-over after WAKE_S), refilled after a full one was sent: its buffer and the
-    writer's still hold the earlier batch's steps past the rows filled, which the writer does not read."""
+    """Also a batch not full (a hand-over after WAKE_S) in a slot that held a full one: the slot still holds the
+    earlier batch's steps past the rows filled, which the writer does not read."""
     sim = Simulation(load_world_text(WORLD, str(tmp_path / "w.world")), seed=2)
     for robot in range(3):
         sim.set_velocity(robot, 0.3, 0.0, 0.2 * robot)
     batch = StepBatch.first(sim, STEPPED, 10)
-    received = None
+    trip = Trip(batch)
     if refilled:
         for _ in range(10):
             sim.step()
             batch.capture(sim)
         assert batch.full
-        received = travelled(batch)
-        batch.clear()
+        assert trip.travel(batch, 1).count == 10
     expected = []
     for _ in range(7):  # not full
         sim.step()
@@ -70,7 +87,7 @@ def test_a_sent_batch_gives_back_every_step(tmp_path, refilled) -> None:
                  for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
     assert not batch.full
-    received = travelled(batch, received)
+    received = trip.travel(batch, 1)
     assert received.count == 7
     values = dict(zip(STEPPED, received.values(), strict=True))
     np.testing.assert_array_equal(received.times, [time_us for time_us, *_ in expected])
