@@ -18,6 +18,10 @@ Every run steps on the compiled kernels from its first step (``STAGE_SIM_KERNELS
   bag (a recording leaves a core to its writer process); when they differ, each pair has a third run, plain
   on the recording's threads, which parts the cost in two medians: ``core_cost_pct``, what giving the core
   away costs a plain run, and ``writer_cost_pct``, what recording costs on the same threads;
+  ``neighbour_cost_pct``, the median over the pairs of what a busy neighbour costs a plain run on the
+  recording's threads: the same run while another process spins (a Python loop) on the core left to the writer.
+  Any writer process costs the simulation that share of its rate for the fraction of the time it is busy (on
+  a machine whose two vCPUs share a physical core, or a power budget, a busy neighbour slows a core down);
   ``setup_s_plain`` and ``setup_s_bag``, the wall seconds of each process outside its run (imports,
   loading the world, and with a bag starting its writer process), which the rates leave out.
 - ``throughput``: N robots with a 240-beam laser on the rooms map (benchmarks/simulate.py's worlds), recorded:
@@ -52,9 +56,20 @@ STAGE_SIM = Path(sys.executable).with_name("stage_sim")
 RATE = re.compile(r": ([\d.]+) s of sim time in ([\d.]+) s of wall time")
 
 
-def run(world: Path, duration: float, controller: str, bag: Path | None, threads: int | None = None) -> dict:
-    """One ``stage_sim run`` (on ``threads`` threads, else its own choice): sim and wall seconds it reports,
-    and what the bag holds."""
+BUSY = "while True: pass"
+"""The busy neighbour: a process that keeps a core busy, as a bag writer that never waits would."""
+
+
+def run(world: Path, duration: float, controller: str, bag: Path | None, threads: int | None = None,
+        neighbour: bool = False) -> dict:
+    """One ``stage_sim run`` (on ``threads`` threads, else its own choice; beside a busy process if
+    ``neighbour``): sim and wall seconds it reports, and what the bag holds."""
+    if neighbour:
+        with subprocess.Popen([sys.executable, "-c", BUSY]) as busy:
+            try:
+                return run(world, duration, controller, bag, threads)
+            finally:
+                busy.kill()
     command = [str(STAGE_SIM), "run", str(world), "--duration", str(duration), "--speedup", "0",
                "--controller", controller, "--seed", "1"]
     if bag is not None:
@@ -91,13 +106,14 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
     (the runs of a pair share the machine's phase; its speed drifts by tens of percent over minutes), the
     rates the best of each. When a recording simulates on fewer threads than a plain run (it leaves a core
     to its writer), each pair also has a plain run on those threads: what the core given away costs, and
-    what the writer costs on top of it."""
+    what the writer costs on top of it. Each pair also has a plain run on those threads beside a busy process:
+    what any busy writer would cost."""
     full, fewer = threads_for_run(None, 0.0), threads_for_run(None, 0.0, recording=True)
-    plains, bags, narrow = [], [], []
+    plains, bags, narrow, beside = [], [], [], []
     for _ in range(repeat):
         plains.append(run(world, duration, controller, None))
-        if fewer < full:
-            narrow.append(run(world, duration, controller, None, fewer))
+        narrow.append(run(world, duration, controller, None, fewer) if fewer < full else plains[-1])
+        beside.append(run(world, duration, controller, None, fewer, neighbour=True))
         bags.append(run(world, duration, controller, bag))
     plain, recorded = max(plains, key=lambda r: r["sim_rate"]), max(bags, key=lambda r: r["sim_rate"])
     cpu_plain, cpu_bag = min(r["cpu_s"] for r in plains), min(r["cpu_s"] for r in bags)
@@ -113,9 +129,10 @@ def overhead(world: Path, robots: int, controller: str, duration: float, repeat:
         "setup_s_bag": round(min(r["setup_s"] for r in bags), 2),
         "bag_mb": recorded["bag_mb"], "dropped_steps": recorded["dropped_steps"],
         "threads_plain": full, "threads_bag": fewer,
+        "neighbour_cost_pct": round(statistics.median(_pair_costs(narrow, beside)), 1),
         # The two parts of the cost when the recording gives a core away, medians of the same pairs.
         **({"core_cost_pct": round(statistics.median(_pair_costs(plains, narrow)), 1),
-            "writer_cost_pct": round(statistics.median(_pair_costs(narrow, bags)), 1)} if narrow else {})}
+            "writer_cost_pct": round(statistics.median(_pair_costs(narrow, bags)), 1)} if fewer < full else {})}
 
 
 def _pair_costs(before: list[dict], after: list[dict]) -> list[float]:
