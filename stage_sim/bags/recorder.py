@@ -49,8 +49,10 @@ recording reaches the writer, and the disk, within this."""
 SLOTS_BYTES = 64 * 1024 * 1024
 """Memory the slots of a real-time recording may hold (ranges and intensities dominate: 8 bytes per beam); they
 take memory only once used, and the freed ones are reused first."""
-MAX_SLOTS = 4096
-"""At most this many slots: their numbers freed and not yet read fit in the pipe that carries them back."""
+MAX_SLOTS = 2048
+"""At most this many slots: the notes of as many batches in flight (20 bytes each) fit in the steps pipe (64 kB),
+so a real-time recording never waits to send one, and their numbers freed and not yet read fit in the pipe
+that carries them back."""
 START_TIMEOUT_S = 120.0
 """How long the writer process may take to start and create the file (a cold start imports for seconds)."""
 
