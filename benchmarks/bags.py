@@ -1,15 +1,16 @@
 """What recording a bag costs: ``stage_sim run ... --speedup 0`` with and without ``--bag``, and scans recorded
 per wall second for 1 and 100 robots.
 
-Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 6000] [--robots 1 100]``. Each
+Run with the venv's python: ``.venv/bin/python benchmarks/bags.py [--duration 30000] [--robots 1 100]``. Each
 case runs the console script in its own process (as users run it) and reads the sim and wall time it prints;
 one JSON object per line:
 
 Every run steps on the compiled kernels from its first step (``STAGE_SIM_KERNELS=numba``).
 
 - ``overhead``: rooms.world with one robot driven straight for ``--duration`` sim seconds and by the wanderer
-  for ``--wander-duration``, and 100 robots for ``--crowd-duration``, plain and with ``--bag``, ``--repeat``
-  times each (interleaved in pairs): the best sim seconds per wall second of each; ``cost_pct``, how much
+  for ``--wander-duration``, and 100 robots for ``--crowd-duration`` (``--cases`` picks some of the three),
+  plain and with ``--bag``, ``--repeat`` times each (interleaved in pairs): the best sim seconds per wall
+  second of each; ``cost_pct``, how much
   slower the recording run is than the plain run just before it, the median over the pairs (the target:
   <= 15; the machine's speed drifts over minutes, a pair's two runs share its phase), ``cost_pct_pairs`` the
   lowest and highest pair; ``cpu_cost_pct``, the same from the
@@ -56,6 +57,7 @@ STAGE_SIM = Path(sys.executable).with_name("stage_sim")
 RATE = re.compile(r": ([\d.]+) s of sim time in ([\d.]+) s of wall time")
 
 
+CASES = ("straight", "wander", "crowd")
 BUSY = "while True: pass"
 """The busy neighbour: a process that keeps a core busy, as a bag writer that never waits would."""
 
@@ -142,13 +144,16 @@ def _pair_costs(before: list[dict], after: list[dict]) -> list[float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=6000.0,
-                        help="sim seconds of the one-robot overhead runs driven straight (a few wall seconds)")
+    parser.add_argument("--duration", type=float, default=30000.0,
+                        help="sim seconds of the one-robot overhead runs driven straight (a few wall seconds: runs "
+                             "of under a second gave pairs 50 points apart)")
     parser.add_argument("--wander-duration", type=float, default=600.0,
                         help="sim seconds of the one-robot overhead runs driven by the wanderer")
     parser.add_argument("--crowd-duration", type=float, default=60.0,
                         help="sim seconds of the 100-robot overhead runs")
     parser.add_argument("--repeat", type=int, default=5, help="overhead pairs of runs (plain, recorded) per case")
+    parser.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES),
+                        help="overhead cases: one robot driven straight, by the wanderer, 100 robots")
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 100])
     parser.add_argument("--throughput-duration", type=float, default=None,
                         help="sim seconds of each throughput run (default: 600 for one robot, 30 for more)")
@@ -158,9 +163,10 @@ def main() -> None:
         rooms = REPO / "worlds" / "rooms.world"
         crowd = tmp / "robots_100.world"
         crowd.write_text(world_text(100, 240, 240.0, 5.6, seed=1))
-        for world, robots, controller, duration in ((rooms, 1, "straight", args.duration),
-                                                    (rooms, 1, "wander", args.wander_duration),
-                                                    (crowd, 100, "straight", args.crowd_duration)):
+        cases = {"straight": (rooms, 1, "straight", args.duration),
+                 "wander": (rooms, 1, "wander", args.wander_duration),
+                 "crowd": (crowd, 100, "straight", args.crowd_duration)}
+        for world, robots, controller, duration in (cases[name] for name in args.cases):
             print(json.dumps(overhead(world, robots, controller, duration, args.repeat, tmp / "overhead.mcap")),
                   flush=True)
         for robots in args.robots:
