@@ -56,7 +56,6 @@ class FreeSlots:
         """Free slots, the next to use last: the one freed last, whose pages are mapped and warm."""
         self._freed = freed
         os.set_blocking(freed, False)
-        self._partial = b""
         self.writer_gone = False
         """Whether the pipe ended: the writer has exited, and frees nothing more."""
 
@@ -82,10 +81,9 @@ class FreeSlots:
         if not data:
             self.writer_gone = True
             return
-        data, self._partial = self._partial + data, b""
-        whole = len(data) - len(data) % SLOT_NUMBER.itemsize
-        self._partial = data[whole:]
-        self._free.extend(np.frombuffer(data[:whole], SLOT_NUMBER).tolist())
+        # Whole numbers only: each is written at once (4 bytes, under PIPE_BUF), and at most the recorder's
+        # MAX_SLOTS are in the pipe (8 kB), which one read takes.
+        self._free.extend(np.frombuffer(data, SLOT_NUMBER).tolist())
 
     def close(self) -> None:
         os.close(self._freed)

@@ -179,7 +179,7 @@ class _Scans(_Column):
 
 def _copy_rows(arrays: Sequence[np.ndarray], rows: np.ndarray) -> None:
     """Copy ``arrays``, one per row of ``rows`` and each of its dtype and row shape, into ``rows``: their bytes end
-    to end, joined by one C call (np.concatenate checked and converted each small array, four times as long).
+    to end, joined by one C call (np.concatenate checked and converted each small array: two to four times as long).
     An array of another size fails (the byte counts differ); the simulation's arrays keep their dtypes."""
     memoryview(rows).cast("B")[:] = b"".join(arrays)
 
