@@ -68,10 +68,6 @@ class FreeSlots:
             self._collect()
         return self._free.pop() if self._free else None
 
-    def put_back(self, slot: int) -> None:
-        """Return a slot taken but not sent."""
-        self._free.append(slot)
-
     def _collect(self) -> None:
         """Add the slots the writer has freed since last time, without waiting."""
         try:

@@ -284,10 +284,6 @@ class StepBatch:
         self.count = 0
         self._kept.clear()
 
-    @property
-    def full(self) -> bool:
-        return self.count == self.layout.size
-
     def capture(self, sim: Simulation) -> bool:
         """Keep the step just taken: the quantities of the topics the batch was made for. Whether the batch is
         now full."""

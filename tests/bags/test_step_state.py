@@ -74,19 +74,19 @@ def test_a_sent_batch_gives_back_every_step(tmp_path, refilled) -> None:
     batch = StepBatch.first(sim, STEPPED, 10)
     trip = Trip(batch)
     if refilled:
+        full = []
         for _ in range(10):
             sim.step()
-            batch.capture(sim)
-        assert batch.full
+            full.append(batch.capture(sim))
+        assert full == [False] * 9 + [True]  # capture says when the batch is full
         assert trip.travel(batch, 1).count == 10
     expected = []
     for _ in range(7):  # not full
         sim.step()
-        batch.capture(sim)
+        assert not batch.capture(sim)
         scans = {(r, k): (s.ranges.copy(), s.intensities.copy()) if s.stamp == sim.sim_time else None
                  for r, robot in enumerate(sim.scans) for k, s in enumerate(robot)}
         expected.append((sim.sim_time_us, sim.odometry_poses.copy(), sim.true_velocities.copy(), scans))
-    assert not batch.full
     received = trip.travel(batch, 1)
     assert received.count == 7
     values = dict(zip(STEPPED, received.values(), strict=True))
