@@ -25,7 +25,7 @@ layer). The filled footprints are made only when a map is asked for.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from itertools import groupby
 
@@ -225,24 +225,39 @@ def polygon_edges(vertices: np.ndarray) -> np.ndarray:
 
 
 def with_models(raster: StaticRaster, models: list[Model],
-                trace: Callable[[np.ndarray], np.ndarray] = polygon_edges) -> StaticRaster | None:
+                trace: Callable[[np.ndarray], np.ndarray] = polygon_edges) -> StaticRaster:
     """The raster of a world that is ``raster``'s with the top-level ``models`` appended (an episode's
-    obstacles): the bodies already rasterised are shared, only the new ones are traced, each polygon by
-    ``trace`` (:func:`polygon_edges`, or its compiled twin). It is the one :func:`build_static_raster` makes of
-    that world while every new cell lies on the grid; None when one does not (the grid would grow, and
-    everything be placed anew)."""
+    obstacles): the one :func:`build_static_raster` makes of that world, with only the new bodies traced, each
+    polygon by ``trace`` (:func:`polygon_edges`, or its compiled twin). While every new cell lies on the grid the
+    bodies already rasterised are shared and the new raster extends the old one's tiles; a new cell off the grid
+    grows it (to the box a raster of the whole world would have) and the old outlines are moved onto it."""
     shapes = _world_shapes(models)
     vertices = [vertex_cells(part.points, raster.resolution) for part in shapes]
     outlines = [trace(v) for v in vertices]
-    low = np.array([round(raster.origin_xy[0] / raster.resolution), round(raster.origin_xy[1] / raster.resolution)])
+    resolution = raster.resolution
+    low = np.array([round(raster.origin_xy[0] / resolution), round(raster.origin_xy[1] / resolution)])
     high = low + np.array(raster.shape[::-1]) - 1
     stacked = np.concatenate([np.zeros((0, 2), dtype=np.int64), *vertices, *outlines])
     if len(stacked) and ((stacked.min(axis=0) < low).any() or (stacked.max(axis=0) > high).any()):
-        return None
-    frame = (raster.resolution, raster.origin_xy, raster.shape)
+        grown_low, grown_high = np.minimum(low, stacked.min(axis=0)), np.maximum(high, stacked.max(axis=0))
+        shape = (int(grown_high[1] - grown_low[1]) + 1, int(grown_high[0] - grown_low[0]) + 1)
+        frame = (resolution, (float(grown_low[0]) * resolution, float(grown_low[1]) * resolution), shape)
+        kept = [_moved(body, low - grown_low, raster.shape[1], frame) for body in raster.bodies]
+        bodies = [*kept, *_static_bodies(shapes, outlines, grown_low, frame)]
+        return StaticRaster(shape=shape, resolution=resolution, origin_xy=frame[1], bodies=bodies)
+    frame = (resolution, raster.origin_xy, raster.shape)
     bodies = [*raster.bodies, *_static_bodies(shapes, outlines, low, frame)]
-    return StaticRaster(shape=raster.shape, resolution=raster.resolution, origin_xy=raster.origin_xy, bodies=bodies,
+    return StaticRaster(shape=raster.shape, resolution=resolution, origin_xy=raster.origin_xy, bodies=bodies,
                         extends=raster)
+
+
+def _moved(body: StaticBody, shift: np.ndarray, width: int,
+           frame: tuple[float, tuple[float, float], tuple[int, int]]) -> StaticBody:
+    """``body`` on a grown grid (``frame``) whose cell ``-shift`` (columns, rows) was the old grid's (0, 0),
+    ``width`` the old grid's columns: its outline cells keep their row-major order, so they stay sorted."""
+    rows, cols = np.divmod(body.outline, width)
+    outline = (rows + shift[1]) * frame[2][1] + cols + shift[0]
+    return replace(body, outline=outline, frame=frame)
 
 
 def _static_bodies(

@@ -87,16 +87,16 @@ class Simulation:
         """A simulation of ``description``, this world with static models added (an episode's obstacles): what
         ``Simulation(description, seed)`` with this one's watchdog, kernels and threads gives.
 
-        Built from this simulation's robots and raster, only the new bodies traced, when ``description`` keeps
-        this world's top-level models (the very objects, in order), adds no robot, puts the new static models
-        after this world's and they fit on its grid (an environment's reset builds one world per episode);
-        else built from scratch."""
+        Built from this simulation's robots and raster, only the new bodies traced (the grid grown when they
+        reach past it), when ``description`` keeps this world's top-level models (the very objects, in order),
+        adds no robot and puts the new static models after this world's (an environment's reset builds one
+        world per episode); else built from scratch."""
         added = self._added_static(description)
+        if added is None:
+            return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         # Traced on the kernels the new simulation starts on: not this one's, which a base world that is never
         # stepped (an env's) keeps on numpy for good, its upgrade never adopted.
-        static = None if added is None else with_models(self.static, added, backend_for(self._starting_kernels()).trace)
-        if static is None:
-            return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
+        static = with_models(self.static, added, backend_for(self._starting_kernels()).trace)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
         sim._furnish(description, static, self._sensing)
         sim.reset(seed)

@@ -377,13 +377,41 @@ def test_a_world_with_static_models_added_simulates_as_if_built_from_scratch(ker
     assert built.description is extended and built.warnings == fresh.warnings
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
+def test_static_models_that_reach_past_the_grid_grow_it_as_a_world_built_from_scratch(kernels: str) -> None:
+    # An episode's box drawn against a wall pokes out of the world's box: the grid grows on both sides (the old
+    # outlines move onto it), and the simulation is still the base's robots over the new raster.
+    robots = 'bot( pose [9 5 0 0] ) bot( pose [1 1 0 -135] )'
+    base = world(robots)
+    boxes = load_world_text(ROOM.format(drive="diff", extra="") + robots
+                            + 'model( name "out_east" size [1 1 1] pose [10.2 5 0 45] )'
+                            + 'model( name "out_south_west" size [0.6 0.6 1] pose [0 0 0 20] )', "test.world")
+    extended = WorldDescription(base.path, base.settings, [*base.models, *boxes.models[-2:]])
+    original = Simulation(base, seed=1, kernels=kernels)
+    built, fresh = original.with_static_models(extended, seed=4), Simulation(extended, seed=4, kernels=kernels)
+    assert built.robots is original.robots  # not built from scratch
+    assert built.static.shape != original.static.shape
+    assert built.static.shape == fresh.static.shape and built.static.origin_xy == fresh.static.origin_xy
+    for mine, theirs in zip(built.static.bodies, fresh.static.bodies, strict=True):
+        assert mine.name == theirs.name and np.array_equal(mine.outline, theirs.outline)
+        assert np.array_equal(mine.cells, theirs.cells)
+    for sim in (built, fresh):
+        for _ in range(30):
+            sim.set_velocity(0, 0.5, 0.0, 0.0)  # into the box that pokes through the east wall
+            sim.set_velocity(1, 0.4, 0.0, 0.1)
+            sim.step()
+    assert built.stalled[0] and np.array_equal(built.true_poses, fresh.true_poses)
+    assert np.array_equal(built.stalled, fresh.stalled)
+    assert all(np.array_equal(a[0].ranges, b[0].ranges) and np.array_equal(a[0].intensities, b[0].intensities)
+               for a, b in zip(built.scans, fresh.scans, strict=True))
+
+
 def test_a_world_that_is_not_this_one_plus_static_models_is_built_from_scratch() -> None:
     sim = sim_of('bot( pose [2 5 0 0] )')
-    far = load_world_text(ROOM.format(drive="diff", extra="") + 'model( size [1 1 1] pose [30 30 0 0] )', "f.world")
-    grown = WorldDescription(sim.description.path, sim.description.settings, [*sim.description.models, far.models[-1]])
     other = world('bot( pose [3 5 0 0] )')
-    for description in (grown, other):  # the grid grows; other objects (a robot elsewhere)
-        made = sim.with_static_models(description, seed=0)
-        assert made.static.shape == Simulation(description, seed=0).static.shape
-        assert made.true_poses.tolist() == Simulation(description, seed=0).true_poses.tolist()
-    assert sim.with_static_models(grown).static.shape != sim.static.shape
+    made = sim.with_static_models(other, seed=0)  # other objects (a robot elsewhere): nothing to share
+    assert made.robots is not sim.robots
+    assert made.static.shape == Simulation(other, seed=0).static.shape
+    assert made.true_poses.tolist() == Simulation(other, seed=0).true_poses.tolist()
+
+
