@@ -64,7 +64,7 @@ class Sizes:
 
 
 FULL = Sizes(lockstep_s=300.0, robots=100, complete_s=600.0, soak_s=600.0, window_s=30.0, kill_after_s=(5, 20, 60))
-QUICK = Sizes(lockstep_s=20.0, robots=10, complete_s=20.0, soak_s=12.0, window_s=3.0, kill_after_s=(3,))
+QUICK = Sizes(lockstep_s=10.0, robots=10, complete_s=20.0, soak_s=12.0, window_s=3.0, kill_after_s=(2,))
 
 
 def bag_messages(path: Path) -> list[tuple[str, int, bytes]]:

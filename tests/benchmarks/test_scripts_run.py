@@ -18,7 +18,7 @@ CHROMIUM = Path("/usr/bin/chromium")
 TINY = {
     # One overhead case: the others run the same code on other worlds and controllers, a few process starts each.
     "bags": ["--duration", "5", "--cases", "straight", "--repeat", "1", "--robots", "1", "--throughput-duration", "2"],
-    "envs": ["--seconds", "0.3", "--episodes", "0"],
+    "envs": ["--seconds", "0.3", "--episodes", "0", "--worlds", "4"],
     "fidelity": ["--variants", "B", "--robot-worlds", "crowd_100", "--robot-seconds", "1"],
     "jump_chain": [],
     "raycast": ["--poses", "4", "--robots", "20", "--repeats", "1"],
