@@ -12,7 +12,9 @@ Every draw comes from the generator the environment seeds at reset, so a seed fi
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -59,7 +61,11 @@ class ScenarioOptions:
 
 
 class Scenario:
-    """Builds the base world once and, per episode, its obstacles (if any), starts and goals."""
+    """Builds the base world once and, per episode, its obstacles (if any), starts and goals.
+
+    One scenario can serve several tasks (a vector env's worlds): what depends on the base world alone is worked
+    out once for all of them (the base simulation of worlds that change per episode, the free space of the base
+    world), and each simulation placed in gets its own free space, derived from the base's."""
 
     def __init__(self, options: ScenarioOptions) -> None:
         self.options = options
@@ -72,8 +78,15 @@ class Scenario:
         robots = robots_text(generated, options.body, world_centre(plain)) if generated else ""
         self.base = self.source.load(robots, bool(options.n_robots)) if generated else plain
         self._base_space: FreeSpace | None = None
-        self._space: tuple[Simulation, FreeSpace] | None = None
         self._root_space: FreeSpace | None = None
+        # The free space of each simulation placed in, for as long as it lives (a task's current world).
+        self._spaces: weakref.WeakKeyDictionary[Simulation, FreeSpace] = weakref.WeakKeyDictionary()
+
+    @cached_property
+    def simulation(self) -> Simulation:
+        """The base world's simulation, from which every episode's world is made when :attr:`changes_world`:
+        shared by the tasks of this scenario, and never stepped."""
+        return Simulation(self.base)
 
     @property
     def changes_world(self) -> bool:
@@ -100,14 +113,16 @@ class Scenario:
         """Start poses (A, 3) and goals (A, 2) of the agents; other robots stay where the world put them."""
         if self.options.scenario == "circle":
             return self._circle(len(agents), rng)
-        if self._space is None:
-            self._space = (sim, FreeSpace(sim, agents, self.options.clearance))
-            self._root_space = self._space[1]
-        elif self._space[0] is not sim:
-            # The static world of a simulation never changes: its free space is worked out once; an episode's
-            # world is the first one (the base, which check_room places in) with obstacles added.
-            self._space = (sim, self._root_space.with_world(sim))
-        space = self._space[1]
+        # The static world of a simulation never changes: its free space is worked out once. The first is the
+        # base's (check_room places in it); the others (an episode's world: the base with obstacles added, or
+        # another task's simulation of the base) are derived from it, redone only where they differ.
+        space = self._spaces.get(sim)
+        if space is None:
+            if self._root_space is None:
+                space = self._root_space = FreeSpace(sim, agents, self.options.clearance)
+            else:
+                space = self._root_space.with_world(sim)
+            self._spaces[sim] = space
         others = np.array([r.start[:2] for r in sim.robots if r.index not in agents]).reshape(-1, 2)
         return space.starts_and_goals(rng, len(agents), others, self.options.min_goal_distance)
 

@@ -173,7 +173,9 @@ class NavigationTask:
     def __init__(self, scenario: Scenario, config: TaskConfig, agents: list[int] | None = None) -> None:
         self.scenario = scenario
         self.config = config
-        self._base = Simulation(scenario.base)
+        # The base of worlds made per episode is shared with the scenario's other tasks; a fixed world is stepped,
+        # each task its own.
+        self._base = scenario.simulation if scenario.changes_world else Simulation(scenario.base)
         self.sim = self._base
         self.agents = list(range(len(self._base.robots))) if agents is None else list(agents)
         self._agent_rows = np.asarray(self.agents, dtype=np.int64)

@@ -52,7 +52,8 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         if options.scenario == "circle":
             raise ValueError("circle crossing needs several robots: use stage_sim.envs.NavigateParallelEnv")
         self.config = TaskConfig(history, max_steps, discrete, reward or RewardConfig())
-        self.tasks = [NavigationTask(Scenario(options), self.config, agents=[robot]) for _ in range(num_envs)]
+        scenario = Scenario(options)  # the base world, its simulation and free space: one for all worlds
+        self.tasks = [NavigationTask(scenario, self.config, agents=[robot]) for _ in range(num_envs)]
         first = self.tasks[0]
         self.num_envs = num_envs
         self.robot = robot
