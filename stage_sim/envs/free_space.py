@@ -66,7 +66,7 @@ class FreeSpace:
             from stage_sim.envs.free_space_kernels import clear_near
 
             valid = np.ones(padded.shape, dtype=bool)
-            clear_near(valid, padded, np.flatnonzero(padded), self._spans)
+            clear_near(valid, padded, self._spans)
             valid = np.ascontiguousarray(valid[1:-1, 1:-1])
         else:
             valid = ndimage.distance_transform_edt(~padded)[1:-1, 1:-1] * static.resolution > self._reach

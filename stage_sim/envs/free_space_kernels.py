@@ -4,14 +4,14 @@
 (what :meth:`~stage_sim.envs.free_space.FreeSpace.with_world` finds with distance transforms around them).
 
 Why: an obstacles episode redoes both once per reset, and scipy takes milliseconds on a 30 m world at 5 cm.
-Labels: one raster pass with a union-find whose roots are always the older provisional label, then labels
-numbered by their region's first cell in raster order, as scipy numbers them. Near cells: every cell within
-the reach of a new cell's disk of offsets, the disk drawn with the very distances scipy's exact transform
-computes (``sqrt(dy² + dx²) · resolution``, compared the same way). Both give the reference's arrays bit for
-bit (``tests/envs/test_free_space_kernels.py``, ``tests/envs/test_placement.py``). Used when the simulation
-runs the numba kernels. Footprints: a cell is inside when its centre is left of an odd number of the polygons'
-edges that span its row (even-odd), each crossing computed as numpy computes it; numpy's version costs some
-0.1 ms of small array operations per box.
+Labels: one raster pass with a union-find whose roots are always the older provisional label, then labels numbered
+by their region's first cell in raster order, as scipy numbers them. Near cells: every cell within the reach of a
+blocked cell's disk of offsets, the disk drawn with the very distances scipy's exact transform computes
+(``sqrt(dy² + dx²) · resolution``, compared the same way), a run of blocked cells at a time. Both give the
+reference's arrays bit for bit (``tests/envs/test_free_space_kernels.py``, ``tests/envs/test_placement.py``). Used
+when the simulation runs the numba kernels. Footprints: a cell is inside when its centre is left of an odd number
+of the polygons' edges that span its row (even-odd), each crossing computed as numpy computes it; numpy's version
+costs some 0.1 ms of small array operations per box.
 """
 
 from __future__ import annotations
@@ -98,34 +98,14 @@ def label_into(valid, labels):
     return count
 
 
-def clear_near(valid: np.ndarray, solid: np.ndarray, cells: np.ndarray, spans: np.ndarray) -> None:
-    """Clear in ``valid`` (H, W) the flat ``cells``, each set in ``solid`` (H, W), and every cell of a disk around
-    one of them, given by its rows: ``spans`` (R, 3) holds (row offset, first and last column offset) of each (a
-    disk's row is one run of cells, cleared in one inner loop). Only the cells with a neighbour not set in
-    ``solid`` draw their disk: the cell of ``solid`` nearest to any other cell is one of those (a step from a
-    cell whose neighbours are all set towards it comes nearer)."""
-    clear_near_into(valid, solid, cells, spans)
-
-
-@numba.njit(**_JIT)
-def clear_near_into(valid, solid, cells, spans):
-    """:func:`clear_near`."""
+def clear_near(valid: np.ndarray, blocked: np.ndarray, spans: np.ndarray) -> None:
+    """Clear in ``valid`` (H, W) every cell ``blocked`` (H, W) holds and every cell of a disk around one of them,
+    given by its rows: ``spans`` (R, 3) holds (row offset, first and last column offset) of each (a disk's row is
+    one run of cells). A whole world's free space; :func:`add_bodies` clears near an episode's new bodies the
+    same way (:func:`_clear_near_box`), in their boxes only."""
     height, width = valid.shape
-    for cell in cells:
-        r, c = cell // width, cell % width
-        valid[r, c] = False
-        inner = 0 < r < height - 1 and 0 < c < width - 1
-        if inner:
-            for dr in (-1, 0, 1):
-                for dc in (-1, 0, 1):
-                    inner = inner and solid[r + dr, c + dc]
-        if inner:
-            continue
-        for k in range(spans.shape[0]):
-            rr = r + spans[k, 0]
-            if 0 <= rr < height:
-                for cc in range(max(c + spans[k, 1], 0), min(c + spans[k, 2], width - 1) + 1):
-                    valid[rr, cc] = False
+    _clear_near_box(valid, blocked, np.array([0, height, 0, width], dtype=np.int64), spans,
+                    np.empty(0, dtype=np.int64), -1)
 
 
 def add_bodies(blocked: np.ndarray, valid: np.ndarray, bodies: list[StaticBody],
@@ -196,11 +176,11 @@ def add_bodies_into(blocked, valid, outlines, outline_starts, points, polygon_st
 @numba.njit(**_JIT)
 def _clear_near_box(valid, blocked, box, spans, lost, gone):
     """Clear in ``valid`` the cells within ``spans`` of a blocked cell in ``box`` (first row, last row + 1, first
-    column, last column + 1), appending those that were set to ``lost`` from ``gone`` on; returns the new count.
-    What :func:`clear_near` does for each of those cells, row by row: a run of blocked cells clears, in each
-    row of the disk, one run from its first cell's disk to its last's (their disks' union), and the runs a row
-    gets are summed in a difference array before it is cleared, so that no cell is looked at once per disk.
-    Blocked cells that are not new clear only cells already invalid (none is valid within reach of one)."""
+    column, last column + 1), appending those that were set to ``lost`` from ``gone`` on (``gone`` -1: keep no
+    list); returns the new count. Row by row: a run of blocked cells clears, in each row of the disk, one run
+    from its first cell's disk to its last's (their disks' union), and the runs a row gets are summed in a
+    difference array before it is cleared, so that no cell is looked at once per disk. In an episode's box,
+    blocked cells that are not new clear only cells already invalid (none is valid within reach of one)."""
     height, width = valid.shape
     rise, widest = np.abs(spans[:, 0]).max(), max(-spans[:, 1].min(), spans[:, 2].max())
     top, bottom = max(box[0] - rise, 0), min(box[1] + rise, height)
@@ -229,8 +209,9 @@ def _clear_near_box(valid, blocked, box, spans, lost, gone):
             covered += runs[rr - top, cc - left]
             if covered > 0 and valid[rr, cc]:
                 valid[rr, cc] = False
-                lost[gone] = rr * width + cc
-                gone += 1
+                if gone >= 0:
+                    lost[gone] = rr * width + cc
+                    gone += 1
     return gone
 
 

@@ -60,7 +60,7 @@ def test_cells_near_new_bodies_are_those_a_distance_transform_finds(reach: float
         added |= rng.random(added.shape) < 0.01
         valid = rng.random(added.shape) < 0.9
         expected = valid & (ndimage.distance_transform_edt(~added) * resolution > reach)
-        clear_near(valid, added, np.flatnonzero(added), spans)
+        clear_near(valid, added, spans)
         np.testing.assert_array_equal(valid, expected)
 
 
@@ -97,10 +97,10 @@ def test_compiled_footprints_are_the_bodies_filled_cells(resolution: float) -> N
         before = marked.copy()
         spans = _disk((0.06, 0.35, 0.61)[trial % 3], resolution)
         valid = rng.random(shape) < 0.9
-        clear_near(valid, before, np.flatnonzero(before), spans)  # a free space: nothing valid near a blocked cell
+        clear_near(valid, before, spans)  # a free space: nothing valid near a blocked cell
         start = valid.copy()
         reference = valid.copy()
-        clear_near(reference, expected | before, np.flatnonzero(expected & ~before), spans)
+        clear_near(reference, expected | before, spans)
         lost, boxes = add_bodies(marked, valid, [body], spans)
         np.testing.assert_array_equal(marked, expected | before)
         np.testing.assert_array_equal(valid, reference)
