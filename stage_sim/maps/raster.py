@@ -213,10 +213,16 @@ def build_static_raster(
         corners.append(vertex_cells(np.array([[x - r, y - r], [x + r, y + r]]), resolution))
     stacked = np.concatenate(corners)
     low, high = (stacked.min(axis=0), stacked.max(axis=0)) if len(stacked) else (np.zeros(2, int), np.ones(2, int))
+    frame = _frame(low, high, resolution)
+    bodies = _static_bodies(shapes, outlines, low, frame)
+    return StaticRaster(shape=frame[2], resolution=resolution, origin_xy=frame[1], bodies=bodies)
+
+
+def _frame(low: np.ndarray, high: np.ndarray,
+           resolution: float) -> tuple[float, tuple[float, float], tuple[int, int]]:
+    """(resolution, origin, shape) of the grid whose first and last cells are ``low`` and ``high`` (col, row)."""
     shape = (int(high[1] - low[1]) + 1, int(high[0] - low[0]) + 1)
-    origin = (float(low[0]) * resolution, float(low[1]) * resolution)
-    bodies = _static_bodies(shapes, outlines, low, (resolution, origin, shape))
-    return StaticRaster(shape=shape, resolution=resolution, origin_xy=origin, bodies=bodies)
+    return resolution, (float(low[0]) * resolution, float(low[1]) * resolution), shape
 
 
 def polygon_edges(vertices: np.ndarray) -> np.ndarray:
@@ -240,11 +246,10 @@ def with_models(raster: StaticRaster, models: list[Model],
     stacked = np.concatenate([np.zeros((0, 2), dtype=np.int64), *vertices, *outlines])
     if len(stacked) and ((stacked.min(axis=0) < low).any() or (stacked.max(axis=0) > high).any()):
         grown_low, grown_high = np.minimum(low, stacked.min(axis=0)), np.maximum(high, stacked.max(axis=0))
-        shape = (int(grown_high[1] - grown_low[1]) + 1, int(grown_high[0] - grown_low[0]) + 1)
-        frame = (resolution, (float(grown_low[0]) * resolution, float(grown_low[1]) * resolution), shape)
+        frame = _frame(grown_low, grown_high, resolution)
         kept = [_moved(body, low - grown_low, raster.shape[1], frame) for body in raster.bodies]
         bodies = [*kept, *_static_bodies(shapes, outlines, grown_low, frame)]
-        return StaticRaster(shape=shape, resolution=resolution, origin_xy=frame[1], bodies=bodies)
+        return StaticRaster(shape=frame[2], resolution=resolution, origin_xy=frame[1], bodies=bodies)
     frame = (resolution, raster.origin_xy, raster.shape)
     bodies = [*raster.bodies, *_static_bodies(shapes, outlines, low, frame)]
     return StaticRaster(shape=raster.shape, resolution=resolution, origin_xy=raster.origin_xy, bodies=bodies,
