@@ -7,17 +7,19 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   0.05 m resolution, starts and goals drawn from free space. Every agent drives a fixed arc (0.5 m/s,
   0.3 rad/s); episodes that end (a collision, the 500-step limit) are reset, and resets count in the time.
   ``core_share`` is the part of that time spent inside ``Simulation.step`` (moving robots, casting every
-  laser; for the vector env its ``SimulationBatch.step``); the rest is the environments' own work
-  (observations, rewards, dicts, resets).
+  laser; ``Simulation.step_with`` when an env's step is one compiled call, which then makes the commands,
+  observations and rewards too; for the vector env its ``SimulationBatch.step``); the rest is the environments'
+  own work (dicts, resets; observations and rewards where they are not in that call).
   ``NavigateVectorEnv`` (``--worlds``, default 64 one-robot worlds) counts env steps summed over its worlds.
   For the parallel env, ``robot_steps_per_s`` counts every robot of every step (every laser is cast every
   step, also those of agents that are done and stay as obstacles) and ``agent_steps_per_s`` only the live
   agents.
 * ``breakdown``: where the time of a one-robot ``NavigateEnv`` step goes on ``benchmarks/rl_peers.py``'s
   scenario (the obstacles scenario: 8 boxes of 0.3–1 m drawn anew each episode, a uniformly random action per
-  step, episodes reset as they end): ``kernel_us`` inside the compiled step (moves, contacts and the ray walk),
-  ``step_glue_us`` the rest of ``Simulation.step`` (Python and numpy around it), ``env_us`` the env's own
-  work per step (actions, goal, observation, reward, info), ``reset_us`` the resets' time per step
+  step, episodes reset as they end): ``kernel_us`` inside the compiled call (moves, contacts and the ray walk;
+  with the task's commands, observation and reward, which the env's step makes in the same call),
+  ``step_glue_us`` the rest of ``Simulation.step_with`` (Python and numpy around it), ``env_us`` the env's own
+  Python per step (actions, result, info), ``reset_us`` the resets' time per step
   (``ms_per_reset`` each: a new world with the episode's boxes, free space, placement). The same for the vector
   env of ``--worlds`` worlds, per world step: its worlds step in one compiled call
   (:class:`~stage_sim.sim.simulation.SimulationBatch`), whose time per world is ``kernel_us``, and
@@ -147,11 +149,12 @@ class Breakdown:
         from stage_sim.sim import fused_kernels
 
         spent, worlds, count, actions, env = self.spent, self.worlds, self.count, self.actions, self.env
-        # the compiled step: one world's, or every world's in one call (the vector env's SimulationBatch; its
-        # kernel calls the other, which must stay the compiled one)
-        kernels = {name: getattr(fused_kernels, name) for name in (("whole_steps",) if worlds else ("whole_step",))}
+        # the compiled step: one world's (with the task's commands and observations when the env steps in one
+        # call), or every world's in one call (the vector env's SimulationBatch; its kernel calls the other,
+        # which must stay the compiled one)
+        kernels = {name: getattr(fused_kernels, name) for name in (("whole_steps",) if worlds else ("commanded_step",))}
         stepper = SimulationBatch if worlds else Simulation
-        step, reset = stepper.step, NavigationTask.reset
+        step, step_with, reset = stepper.step, Simulation.step_with, NavigationTask.reset
 
         def timed(kernel: Callable[..., object]) -> Callable[..., object]:
             def timed_kernel(*args: object) -> object:
@@ -167,6 +170,13 @@ class Breakdown:
             step(*args)
             spent["step"] += time.perf_counter() - start
 
+        def timed_step_with(sim: Simulation, kernel: Callable[..., int], arguments: tuple) -> bool:
+            start = time.perf_counter()
+            try:
+                return step_with(sim, timed(kernel), arguments)
+            finally:
+                spent["step"] += time.perf_counter() - start
+
         def timed_reset(task: NavigationTask, generator: np.random.Generator) -> np.ndarray:
             inside = spent["kernel"], spent["step"]
             began = time.perf_counter()
@@ -179,6 +189,8 @@ class Breakdown:
         for name, kernel in kernels.items():
             setattr(fused_kernels, name, timed(kernel))
         stepper.step, NavigationTask.reset = timed_step, timed_reset
+        if not worlds:
+            Simulation.step_with = timed_step_with
         try:
             steps = self.steps
             start = time.perf_counter()
@@ -195,7 +207,7 @@ class Breakdown:
         finally:
             for name, kernel in kernels.items():
                 setattr(fused_kernels, name, kernel)
-            stepper.step, NavigationTask.reset = step, reset
+            stepper.step, Simulation.step_with, NavigationTask.reset = step, step_with, reset
 
     def row(self) -> dict:
         """The JSON line of what was measured."""
@@ -222,16 +234,24 @@ def breakdowns(seconds: float, worlds: list[int]) -> list[dict]:
 
 
 def time_core(sim: Simulation) -> list[float]:
-    """Make ``sim`` add the wall seconds of each of its steps to the returned one-element list."""
+    """Make ``sim`` add the wall seconds of each of its steps (those an env makes in one call too) to the returned
+    one-element list."""
     spent = [0.0]
-    step = sim.step
+    step, step_with = sim.step, sim.step_with
 
     def timed_step() -> None:
         start = time.perf_counter()
         step()
         spent[0] += time.perf_counter() - start
 
-    sim.step = timed_step
+    def timed_step_with(kernel: Callable[..., int], arguments: tuple) -> bool:
+        start = time.perf_counter()
+        try:
+            return step_with(kernel, arguments)
+        finally:
+            spent[0] += time.perf_counter() - start
+
+    sim.step, sim.step_with = timed_step, timed_step_with
     return spent
 
 

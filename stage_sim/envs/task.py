@@ -80,7 +80,8 @@ class TaskConfig:
 
 @dataclass
 class StepResult:
-    """Per agent (A,) arrays of one step; ``active`` tells which agents were still in the episode."""
+    """Per agent (A,) arrays of one step; ``active`` tells which agents were still in the episode. The arrays
+    other than the observations may be the task's own, written again by its next step."""
 
     observations: np.ndarray
     rewards: np.ndarray
@@ -167,6 +168,31 @@ def compiled_finish_step(
     return StepResult(rows, rewards, flags[0], flags[1], flags[2], flags[3], distance, flags[4])
 
 
+class _CompiledStep:
+    """A task's whole step in one compiled call (:mod:`stage_sim.envs.step_kernels`' ``continuous_step`` or
+    ``discrete_step``, through :meth:`~stage_sim.sim.simulation.Simulation.step_with`): the tables it reads and
+    writes, and the step results' arrays, which are views of them."""
+
+    def __init__(self, task: NavigationTask) -> None:
+        kernels = _kernels()
+        observer, actions, count = task._observer, task.actions, len(task.agents)
+        self.kernel = kernels.discrete_step if actions.discrete else kernels.continuous_step
+        self.discrete = actions.discrete
+        self.rewards, self.distance, self.flags = np.zeros(count), np.zeros(count), np.zeros((5, count), dtype=bool)
+        self.tables = kernels.task_tables(
+            task._agent_rows, np.array([task.sim.beams_of(agent).start for agent in task.agents], dtype=np.int64),
+            observer.range_scale, observer.history, observer.tail_low, observer.tail_high,
+            task.config.reward.weights, actions.low, actions.high, actions.table, task.active, self.distance,
+            self.rewards, self.flags)
+        self.size = observer.layout.size
+
+    def actions(self, actions: np.ndarray) -> np.ndarray:
+        """The agents' actions as its kernel takes them: (A,) int64 or (A, 2) float64."""
+        if self.discrete:
+            return np.asarray(actions, dtype=np.int64).reshape(-1)
+        return np.asarray(actions, dtype=np.float64).reshape(-1, 2)
+
+
 class NavigationTask:
     """Episodes of ``scenario`` for the robots ``agents`` (default: every robot of the world)."""
 
@@ -193,6 +219,7 @@ class NavigationTask:
         self.distance = np.zeros(count)
         self.steps = 0
         scenario.check_room(self._base, self.agents)
+        self._compiled: _CompiledStep | None = None  # made at the first step on the compiled kernels
 
     def reset(self, rng: np.random.Generator) -> np.ndarray:
         """A new episode drawn from ``rng``; returns the (A, D) first observations."""
@@ -209,21 +236,39 @@ class NavigationTask:
         self._observer.reset(self.sim)
         self.active[:] = True
         self.steps = 0
-        self.distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        distance, bearing = goal_polar(self.sim.true_poses[self.agents], self.goals)
+        self.distance[:] = distance  # in place: the compiled step's tables hold it
         return self._observer.rows(self.sim, self.distance, bearing)
 
     def step(self, actions: np.ndarray) -> StepResult:
-        """Apply one action per agent (those of finished agents are ignored) and advance one step."""
+        """Apply one action per agent (those of finished agents are ignored) and advance one step: in one compiled
+        call when the simulation's step is one (:meth:`~stage_sim.sim.simulation.Simulation.step_with`), else
+        command, step and score one after the other (the same arrays)."""
         sim, agents = self.sim, self._agent_rows
         compiled = sim.kernels == "numba"
-        (compiled_command_agents if compiled else command_agents)(sim, agents, self.actions, actions, self.active)
-        sim.step()
         self.steps += 1
+        at_limit = self.steps >= self.config.max_steps
+        if compiled and sim.fused_next():
+            whole = self._compiled or self._compile()
+            rows = np.empty((len(agents), whole.size), dtype=np.float32)
+            if sim.step_with(whole.kernel, (whole.tables, whole.actions(actions), sim.last_command_us,
+                                            sim.sim_time_us, self.goals, at_limit, rows)):
+                flags = whole.flags
+                return StepResult(rows, whole.rewards, flags[0], flags[1], flags[2], flags[3], self.distance, flags[4])
+        else:
+            (compiled_command_agents if compiled else command_agents)(sim, agents, self.actions, actions, self.active)
+            sim.step()
         result = (compiled_finish_step if compiled else finish_step)(
-            self._observer, self.config.reward, sim, agents, self.goals, self.distance, self.active,
-            self.steps >= self.config.max_steps)
-        self.distance = result.distance
+            self._observer, self.config.reward, sim, agents, self.goals, self.distance, self.active, at_limit)
+        self.distance[:] = result.distance
         return result
+
+    def _compile(self) -> _CompiledStep:
+        """The tables of its compiled step, made once (its distances become the task's)."""
+        self._compiled = _CompiledStep(self)
+        self._compiled.distance[:] = self.distance
+        self.distance = self._compiled.distance
+        return self._compiled
 
     def frame(self) -> np.ndarray:
         """The world as the renderer draws it, (H, W, 3) uint8, with a cross in its robot's colour at each goal."""

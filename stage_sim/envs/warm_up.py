@@ -16,7 +16,8 @@ from stage_sim.sim import warm_up
 
 def warm() -> None:
     """Run every kernel once (compiling what the cache lacks): the simulation's, then an obstacles episode of a
-    small env with continuous and with discrete actions, stepped and reset on the compiled kernels."""
+    small env with continuous and with discrete actions, stepped (in one call, and part by part) and reset on the
+    compiled kernels."""
     warm_up.warm()
     if not numba_available():
         return
@@ -29,6 +30,9 @@ def warm() -> None:
             env.reset(seed=0)
             for _ in range(2):
                 env.step(env.action_space.sample())
+            # a step not made in one call (the kernels it is made of): a simulation's watchdog is applied apart
+            env.task.sim.watchdog_timeout = 60.0
+            env.step(env.action_space.sample())
             env.reset()  # an episode's free space, derived from the first one's
     finally:
         if asked is None:

@@ -31,7 +31,7 @@ from stage_sim.maps.raster import polygon_edges
 from stage_sim.maps.tiles import CellValues, TileLayer
 from stage_sim.sensing.casters import RayCaster, make_caster
 from stage_sim.sim.collision import Bodies, CollisionChecker, Contact, GridFrame, place
-from stage_sim.sim.drives import DriveGroup
+from stage_sim.sim.drives import DriveGroup, DriveTable
 from stage_sim.sim.kinematics import body_velocity
 from stage_sim.sim.odometry import integrate_odometry
 from stage_sim.sim.ray_groups import SingleCast
@@ -85,10 +85,11 @@ class Motion(Protocol):
 class Fused(Protocol):
     """A whole step in few calls, as the roles give it step by step (:meth:`~stage_sim.sim.compiled.FusedStep.step`)."""
 
-    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
+    def step(self, commands: np.ndarray, poses: np.ndarray, layers: np.ndarray, layer: int, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
-             ) -> FusedResult:
-        """One step, every ray cast when ``cast``, none else: :class:`~stage_sim.sim.compiled.FusedResult`."""
+             kernel: Callable[..., int] | None = None, arguments: tuple = ()) -> FusedResult:
+        """One step from the robots' commands, every ray cast when ``cast``, none else, its compiled call made by
+        ``kernel`` when given: :class:`~stage_sim.sim.compiled.FusedResult`."""
         ...
 
     def warm(self, poses: np.ndarray) -> None:
@@ -112,12 +113,13 @@ class Fused(Protocol):
 
 class FusedFactory(Protocol):
     """The fused step of a world's contacts and rays (:meth:`~stage_sim.sim.rangers.RangerSensing.single_cast`)
-    on ``threads``, or None where it steps role by role."""
+    and its robots' drives on ``threads``, or None where it steps role by role."""
 
-    def __call__(self, collision: Contact, cast: SingleCast | None, threads: int) -> Fused | None: ...
+    def __call__(self, collision: Contact, cast: SingleCast | None, threads: int, drives: DriveTable,
+                 ) -> Fused | None: ...
 
 
-def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int) -> None:
+def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int, drives: DriveTable) -> None:
     """The numpy reference steps role by role: it is what every fused step must give."""
 
 

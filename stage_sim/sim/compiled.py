@@ -9,6 +9,7 @@ twin, on the grid's threads, from :data:`PARALLEL_ITEMS` items on.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
 
@@ -21,7 +22,7 @@ from stage_sim.sensing.fast_caster import PARALLEL_RAYS
 from stage_sim.sensing.robot_layer import MARKED, SEVERAL_ROBOTS
 from stage_sim.sim import body_kernels, fused_kernels, motion_kernels, ranger_kernels
 from stage_sim.sim.collision import CollisionChecker, Contact
-from stage_sim.sim.drives import DriveGroups
+from stage_sim.sim.drives import DriveGroups, DriveTable
 from stage_sim.sim.ray_groups import SingleCast
 
 #: The steering cos and sin given to drives that read none (``Drive.steered``).
@@ -132,6 +133,8 @@ class FusedResult:
     odometry: np.ndarray
     layers: np.ndarray  #: (2, N, 3) the robots' poses in each of Stage's layers
     scans: tuple[np.ndarray, np.ndarray] | None  #: float32 ranges and intensities of every beam (None: no cast)
+    velocities: np.ndarray  #: (N, 3) the body velocities the robots moved with
+    grown: bool = False  #: whether the rays were cast again after the step's call, into a robot layer grown for them
 
 
 class FusedStep:
@@ -141,7 +144,7 @@ class FusedStep:
     height, on one thread (:meth:`of`); other worlds, and steps when only some rangers are due, step role by
     role."""
 
-    def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast) -> None:
+    def __init__(self, collision: CompiledCollisionChecker, cast: SingleCast, drives: DriveTable) -> None:
         bodies, grid = collision.bodies, collision.grid
         static = collision.static_layer()
         group = cast.group
@@ -170,7 +173,8 @@ class FusedStep:
             # the last cast through each layer, kept for the steps whose robots stand still (shared by every pack)
             "cast_keys": np.empty((2, 2, n, 3)), "cast_ranges": np.empty((2, beams)),
             "cast_intensity": np.empty((2, beams), dtype=np.float32), "cast_state": np.zeros((2, 2), dtype=np.int64),
-            "replays": np.zeros(1, dtype=np.int64),
+            "replays": np.zeros(1, dtype=np.int64), "drive_rows": motion_kernels.drive_rows(drives.groups),
+            "wheelbases": drives.wheelbases, "bounds": drives.bounds,
             **dict(zip(("walk_rows", "walk_cols", "walk_tiles", "walk_slots", "walk_rows_used", "walk_cols_used"),
                        world, strict=True)),
             **dict(zip(("last_angle", "last_cos", "last_sin"), cast.trig, strict=True)),
@@ -192,33 +196,39 @@ class FusedStep:
         self._world = fused_kernels.fused_world(*(fields[name] for name in fused_kernels.FIELDS))
 
     @classmethod
-    def of(cls, collision: Contact, cast: SingleCast | None, threads: int) -> FusedStep | None:
+    def of(cls, collision: Contact, cast: SingleCast | None, threads: int, drives: DriveTable) -> FusedStep | None:
         """The fused step of a world's compiled contacts and rays (``cast`` None: not all at one height, or no
-        robot), or None when it steps role by role: robots in several height bands, or more than one thread with
-        more rays than a cast keeps on one (the parallel loops)."""
+        robot) and its robots' ``drives``, or None when it steps role by role: robots in several height bands, or
+        more than one thread with more rays than a cast keeps on one (the parallel loops)."""
         if (cast is None or not isinstance(collision, CompiledCollisionChecker) or collision.static_layer() is None
                 or (threads > 1 and cast.group.rays.size > PARALLEL_RAYS)):
             return None
-        return cls(collision, cast)
+        return cls(collision, cast, drives)
 
-    def step(self, poses: np.ndarray, layers: np.ndarray, layer: int, velocities: np.ndarray, stalled: np.ndarray,
+    def step(self, commands: np.ndarray, poses: np.ndarray, layers: np.ndarray, layer: int, stalled: np.ndarray,
              estimates: np.ndarray, errors: np.ndarray, uses_odom: np.ndarray, dt: float, cast: bool,
-             ) -> FusedResult:
-        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with ``velocities``; every ray cast
-        when ``cast``, none else (no ranger due)."""
+             kernel: Callable[..., int] | None = None, arguments: tuple = ()) -> FusedResult:
+        """One step from ``poses`` in layer ``layer`` of ``layers`` (2, N, 3) with the body velocities of
+        ``commands``; every ray cast when ``cast``, none else (no ranger due).
+
+        ``kernel``: a compiled function called instead of :func:`~stage_sim.sim.fused_kernels.commanded_step` with
+        its arguments, then ``arguments``, which calls it and returns its answer (an RL task's step: commands
+        written before, observations after, in the same call)."""
         world = self.world()
         n, (integrated, end_trig, final_trig) = poses.shape[0], self._scratch
-        odometry, final, stalled_out = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=bool)
+        velocities, odometry, final, stalled_out = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3)), \
+            np.empty(n, dtype=bool)
         layers = layers.copy()
         published, intensity = np.empty(self._beams, dtype=np.float32), np.empty(self._beams, dtype=np.float32)
-        tiles = fused_kernels.whole_step(
-            world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast, integrated,
-            end_trig, final_trig, odometry, final, stalled_out, published, intensity)
+        tiles = (kernel or fused_kernels.commanded_step)(
+            world, commands, velocities, poses, layers, layer, estimates, errors, dt, uses_odom, stalled, cast,
+            integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, *arguments)
         if not cast:
-            return FusedResult(final, stalled_out, odometry, layers, None)
-        if tiles > self._robots.capacity:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
+            return FusedResult(final, stalled_out, odometry, layers, None, velocities)
+        grown = tiles > self._robots.capacity
+        if grown:  # the layer grows (rarely: it never shrinks), and the rays are cast with it
             self.cast_grown(tiles, layers, layer, final, final_trig, published, intensity)
-        return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+        return FusedResult(final, stalled_out, odometry, layers, (published, intensity), velocities, grown)
 
     @property
     def beams(self) -> int:
@@ -251,8 +261,8 @@ class FusedStep:
         (what it remembers is checked at every step)."""
         n = len(poses)
         layers = np.stack([poses, poses])
-        self.step(poses, layers, 0, np.full_like(poses, 1e-3), np.zeros(n, dtype=bool), poses,
-                  np.zeros((n, 4)), np.ones(n, dtype=bool), 0.1, True)
+        self.step(np.full_like(poses, 1e-3), poses, layers, 0, np.zeros(n, dtype=bool), poses, np.zeros((n, 4)),
+                  np.ones(n, dtype=bool), 0.1, True)
         final_trig = self._scratch[2]
         fused_kernels.sense_again(self._world, layers, 0, poses, final_trig, np.empty(self._beams, dtype=np.float32),
                                   np.empty(self._beams, dtype=np.float32))
@@ -308,7 +318,7 @@ class FusedBatch:
             steps[k].cast_grown(int(tiles[slot]), layers[slot], int(parity[slot]), final[slot], final_trig[slot],
                                 published[slot], intensity[slot])
             self._held[slot] = worlds[slot] = steps[k].world()
-        return FusedResult(final, stalled_out, odometry, layers, (published, intensity))
+        return FusedResult(final, stalled_out, odometry, layers, (published, intensity), velocities)
 
     def _hold(self, slots: np.ndarray, steps: list[FusedStep]) -> typed.List:
         """The typed list with each step's world in its slot."""

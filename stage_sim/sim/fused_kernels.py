@@ -55,6 +55,8 @@ FIELDS = (
     # it saw; its ranges before the noise and its intensities; per layer whether one is kept and the tiles it
     # needed; how often one was replayed
     "cast_keys", "cast_ranges", "cast_intensity", "cast_state", "replays",
+    # the body velocities from the commands: each stepped drive's robots, wheelbases, velocity bounds
+    "drive_rows", "wheelbases", "bounds",
 )
 
 
@@ -81,7 +83,7 @@ def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, c
                 walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner, rays, last_angle, last_cos, last_sin,
                 jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss, static_cells, static_values, robot_return,
                 several_return, ranges, cell, hit_robot, headings, known, known_trig, cast_keys, cast_ranges,
-                cast_intensity, cast_state, replays):
+                cast_intensity, cast_state, replays, drive_rows, wheelbases, bounds):
     """A :class:`FusedWorld` of the :data:`FIELDS` (compiled and cached: the proxy's own constructor is not)."""
     return FusedWorld(vertices, poly_start, robot_poly, radius, grid, ppm, collides, colliding, can_clash, slots,
                       tile_of_slot, bits, static_place, ranger_offset, ranger_owner, robots_seen, visible, regions, ids,
@@ -90,7 +92,8 @@ def fused_world(vertices, poly_start, robot_poly, radius, grid, ppm, collides, c
                       walk_rows_used, walk_cols_used, walk_place, stops, pad, walk_ppm, ranger, angle, rmax, owner,
                       rays, last_angle, last_cos, last_sin, jitter, noisy_rays, noise_prop, noise_uniform, noise_gauss,
                       static_cells, static_values, robot_return, several_return, ranges, cell, hit_robot, headings,
-                      known, known_trig, cast_keys, cast_ranges, cast_intensity, cast_state, replays)
+                      known, known_trig, cast_keys, cast_ranges, cast_intensity, cast_state, replays, drive_rows,
+                      wheelbases, bounds)
 
 
 @numba.njit(**_JIT)
@@ -173,6 +176,18 @@ def whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, u
         end_trig[0, k], end_trig[1, k] = math.cos(headings[k, 2]), math.sin(headings[k, 2])
     return step(world, poses, integrated, layers, layer, velocities, stalled, odometry, uses_odom, end_trig, final,
                 stalled_out, final_trig, cast, published, intensity)
+
+
+@numba.njit(**_JIT)
+def commanded_step(world, commands, velocities, poses, layers, layer, estimates, errors, dt, uses_odom, stalled, cast,
+                   integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity):
+    """A whole step from the robots' ``commands``: their body velocities into ``velocities``
+    (:func:`~stage_sim.sim.motion_kernels.drive_velocities`), then :func:`whole_step` with them, whose answer it
+    returns. What :meth:`~stage_sim.sim.compiled.FusedStep.step` calls, or a kernel that wraps it (an RL task's,
+    which writes the commands first and reads the new state after: ``stage_sim.envs.step_kernels``)."""
+    motion_kernels.drive_velocities(commands, world.drive_rows, world.wheelbases, world.bounds, velocities)
+    return whole_step(world, poses, layers, layer, estimates, velocities, errors, dt, uses_odom, stalled, cast,
+                      integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity)
 
 
 @numba.njit(inline="always", **_JIT)

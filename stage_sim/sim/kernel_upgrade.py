@@ -57,6 +57,7 @@ class Upgradable(Protocol):
     robots: list
     start_poses: np.ndarray
     threads: int
+    drives: Any
 
     def build_parts(self, kernels: str) -> tuple[Any, Any]: ...
 
@@ -122,7 +123,7 @@ def build_compiled_parts(sim: Upgradable) -> CompiledParts | None:
     collision.resolve(poses, poses, np.full_like(poses, 1e-3), 0.1, np.ones(len(poses), dtype=bool))  # loads the
     # raster and decision kernels (nothing is kept)
     sensing.sense(poses, 0.0)
-    fused = backend.fused(collision, sensing.single_cast(), sim.threads)
+    fused = backend.fused(collision, sensing.single_cast(), sim.threads, sim.drives)
     if fused is not None:
         fused.warm(poses)
     note_kernels_running(backend.name)

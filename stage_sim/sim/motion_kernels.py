@@ -10,15 +10,21 @@ at a time by each drive's own twin (:mod:`stage_sim.sim.drives`), compiled here.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numba
 import numpy as np
 
-from stage_sim.sim.drives import DRIVES, DriveGroup
+from stage_sim.sim.drives import DRIVES, DriveGroup, DriveGroups
 
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 _VELOCITY_KERNELS = {name: numba.njit(**_JIT)(drive.compiled_velocities) for name, drive in DRIVES.items()}
+#: The drives :func:`drive_velocities` steps, in this order (a compiled function can call a drive's twin only by
+#: name, not from the registry: a new drive is added here too, ``tests/sim/test_motion_kernels.py`` checks).
+STEPPED_DRIVES = ("diff", "omni", "car")
+_diff, _omni, _car = (_VELOCITY_KERNELS[name] for name in STEPPED_DRIVES)
+_NO_ROWS = np.zeros(0, dtype=np.int64)
 
 
 @numba.njit(inline="always", **_JIT)
@@ -34,6 +40,28 @@ def body_velocities(commands: np.ndarray, drives: Sequence[DriveGroup], wheelbas
     one clamping pass; ``cos_steer``/``sin_steer``: numpy's cos/sin of ``commands[:, 2]`` (car drives read them)."""
     for group in drives:
         _VELOCITY_KERNELS[group.drive.name](commands, group.rows, wheelbases, cos_steer, sin_steer, out)
+    clamp_velocities(out, bounds)
+
+
+def drive_rows(drives: DriveGroups) -> tuple[np.ndarray, ...]:
+    """The robots of each of :data:`STEPPED_DRIVES` (int64 rows, empty for a drive no robot has), as
+    :func:`drive_velocities` takes them."""
+    rows = {group.drive.name: group.rows for group in drives}
+    return tuple(rows.get(name, _NO_ROWS) for name in STEPPED_DRIVES)
+
+
+@numba.njit(**_JIT)
+def drive_velocities(commands, rows, wheelbases, bounds, out):
+    """:func:`body_velocities` in one compiled call (a fused step's first part), ``rows`` from :func:`drive_rows`:
+    the cos and sin of the steering angle are libm's, which are numpy's (``tests/sim/test_trigonometry.py``),
+    worked out for the robots of the one steered drive (``car``) only."""
+    n = commands.shape[0]
+    cos_steer, sin_steer = np.empty(n), np.empty(n)
+    for i in rows[2]:
+        cos_steer[i], sin_steer[i] = math.cos(commands[i, 2]), math.sin(commands[i, 2])
+    _diff(commands, rows[0], wheelbases, cos_steer, sin_steer, out)
+    _omni(commands, rows[1], wheelbases, cos_steer, sin_steer, out)
+    _car(commands, rows[2], wheelbases, cos_steer, sin_steer, out)
     clamp_velocities(out, bounds)
 
 
@@ -90,5 +118,6 @@ def warm(robots: int) -> None:
     column, out = np.ones(n), np.empty((n, 3))
     every_drive = [DriveGroup(drive, rows) for drive in DRIVES.values()]
     body_velocities(values, every_drive, column, np.zeros((n, 8)), column, column, out)
+    drive_velocities(values, drive_rows(DriveGroups(every_drive)), column, np.zeros((n, 8)), out)
     integrate_estimates(values, values, np.zeros((n, 4)), 0.1, column, column, flags, values, out)
     place_points(values[:, :2].copy(), rows, values, column, column, np.empty((n, 2)))

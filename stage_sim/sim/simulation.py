@@ -22,9 +22,10 @@ copy (:mod:`stage_sim.bags.step_state`).
 from __future__ import annotations
 
 import copy
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,13 +33,16 @@ from stage_sim.backend import resolve_kernels, resolve_threads
 from stage_sim.maps.raster import StaticRaster, build_static_raster, with_models
 from stage_sim.sim.backends import Backend, FusedBatch, backend_for
 from stage_sim.sim.collision import Bodies, Contact, GridFrame
-from stage_sim.sim.drives import group_by_drive
+from stage_sim.sim.drives import DriveTable, group_by_drive
 from stage_sim.sim.kernel_upgrade import CompiledParts, KernelUpgrade, note_kernels_running, upgrade_wanted
 from stage_sim.sim.kinematics import true_velocities
 from stage_sim.sim.odometry import draw_odom_errors, relative_pose
 from stage_sim.sim.rangers import MeasuredBeams, RangerSensing, Scan
 from stage_sim.sim.robots import RobotSpec, build_robots
 from stage_sim.worldfile.description import Model, WorldDescription, WorldWarning
+
+if TYPE_CHECKING:
+    from stage_sim.sim.compiled import FusedResult
 
 # Sim time is kept in integer microseconds, like Stage, so that no rounding drift accumulates.
 MICROSECONDS = 1_000_000
@@ -73,9 +77,10 @@ class Simulation:
         self._bodies = Bodies.from_polygons([list(r.body) for r in self.robots])
         n = len(self.robots)
         self._start = np.array([r.start for r in self.robots], dtype=np.float64).reshape(n, 3)
-        self._drives = group_by_drive([r.settings.drive for r in self.robots])
-        self._wheelbases = np.array([r.settings.wheelbase for r in self.robots], dtype=np.float64)
-        self._bounds = np.array([r.settings.velocity_bounds for r in self.robots], dtype=np.float64).reshape(n, 8)
+        self._drives = DriveTable(
+            group_by_drive([r.settings.drive for r in self.robots]),
+            np.array([r.settings.wheelbase for r in self.robots], dtype=np.float64),
+            np.array([r.settings.velocity_bounds for r in self.robots], dtype=np.float64).reshape(n, 8))
         self._uses_odom = np.array([r.settings.localization == "odom" for r in self.robots], dtype=bool)
         self._odom_origin = np.array(
             [self._odometry_origin(r) for r in self.robots], dtype=np.float64).reshape(n, 3)
@@ -139,7 +144,8 @@ class Simulation:
         self._upgrade = KernelUpgrade(self) if self._upgrade_wanted() else None
         self._collision, self._sensing = self.build_parts(self.kernels, rangers_of)
         self._motion = backend_for(self.kernels).motion
-        self._fused = backend_for(self.kernels).fused(self._collision, self._sensing.single_cast(), self.threads)
+        self._fused = backend_for(self.kernels).fused(self._collision, self._sensing.single_cast(), self.threads,
+                                                      self._drives)
         note_kernels_running(self.kernels)
         self.warnings = list(self._world_warnings)
         for index in np.flatnonzero(self._collision.overlapping(self._start)):
@@ -229,16 +235,37 @@ class Simulation:
         dt = self.interval_us / MICROSECONDS
         if self.watchdog_timeout > 0:
             self._stop_silent_robots()
-        self.velocities = self._body_velocities()
         layer = self._updates % 2
         fused, now = self._fused is not None, self.sim_time
         cast = fused and self._sensing.all_due(now)
         if cast or (fused and self._sensing.none_due(now)):  # a fused step casts all rangers or none
             self._step_fused(layer, dt, cast)
         else:
+            self.velocities = self._body_velocities()
             self._step_by_roles(layer, dt)
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
+
+    def fused_next(self) -> bool:
+        """Whether the next step is one compiled call that casts every ranger, with no watchdog to apply: a step
+        :meth:`step_with` can make."""
+        return (self._fused is not None and self.watchdog_timeout <= 0
+                and self._sensing.all_due((self.sim_time_us + self.interval_us) / MICROSECONDS))
+
+    def step_with(self, kernel: Callable[..., int], arguments: tuple) -> bool:
+        """:meth:`step`, when :meth:`fused_next`, with its compiled call made by ``kernel``, a compiled function
+        that takes :func:`~stage_sim.sim.fused_kernels.commanded_step`'s arguments, then ``arguments``, and calls
+        it with them, returning its answer. Before the call it may write the robots' commands (stamped at the
+        step's start: :meth:`set_velocities`), after it read the new state: an RL task's step in one call.
+
+        Returns whether the call's view of the scans holds. It does not, rarely, when the robot layer was too
+        small for the cast: the call's own cast is then skipped and the rays are cast again into a grown layer
+        after it (:attr:`measured_beams` has them)."""
+        self.sim_time_us += self.interval_us
+        result = self._step_fused(self._updates % 2, self.interval_us / MICROSECONDS, True, kernel, arguments)
+        if self._upgrade is not None:
+            self._adopt(self._upgrade.poll())
+        return not result.grown
 
     def _stop_silent_robots(self) -> None:
         """The watchdog: zero the commands of the robots not commanded for ``watchdog_timeout``. Commands only
@@ -251,18 +278,21 @@ class Simulation:
         self.commands[silent] = 0.0
         self._oldest_command_us = int(self.last_command_us.min())
 
-    def _step_fused(self, layer: int, dt: float, cast: bool) -> None:
-        """The moves, odometry and (when ``cast``) every ranger's scan of a step in few compiled calls, the same
-        as :meth:`_step_by_roles` gives (the backend's fused step)."""
+    def _step_fused(self, layer: int, dt: float, cast: bool, kernel: Callable[..., int] | None = None,
+                    arguments: tuple = ()) -> FusedResult:
+        """The body velocities, moves, odometry and (when ``cast``) every ranger's scan of a step in one compiled
+        call (``kernel``'s when given, see :meth:`step_with`), the same as :meth:`_body_velocities` and
+        :meth:`_step_by_roles` give (the backend's fused step)."""
         if cast:
             self._sensing.draw_all_noise()
-        fused = self._fused.step(self.true_poses, self._layer_poses, layer, self.velocities, self.stalled,
-                                 self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast)
-        self.true_poses, self.stalled, self.odometry_poses, self._layer_poses = \
-            fused.poses, fused.stalled, fused.odometry, fused.layers
+        fused = self._fused.step(self.commands, self.true_poses, self._layer_poses, layer, self.stalled,
+                                 self.odometry_poses, self.odom_errors, self._uses_odom, dt, cast, kernel, arguments)
+        self.true_poses, self.stalled, self.odometry_poses, self._layer_poses, self.velocities = \
+            fused.poses, fused.stalled, fused.odometry, fused.layers, fused.velocities
         self._updates += 1
         if cast:
             self._sensing.record_all(*fused.scans, self.sim_time)
+        return fused
 
     def _step_by_roles(self, layer: int, dt: float) -> None:
         """The moves, odometry and scans of a step, one role after the other (what the fused step does at once)."""
@@ -296,7 +326,8 @@ class Simulation:
 
     def _body_velocities(self) -> np.ndarray:
         """The body velocities the commands give (drive + ``velocity_bounds``)."""
-        return self._motion.body_velocities(self.commands, self._drives, self._wheelbases, self._bounds)
+        drives = self._drives
+        return self._motion.body_velocities(self.commands, drives.groups, drives.wheelbases, drives.bounds)
 
     def _odometry(self, moved: np.ndarray, dt: float) -> np.ndarray:
         """Odometry after the step: integrated with the odom errors, or the true pose (gps localization)."""
@@ -314,6 +345,11 @@ class Simulation:
     def start_poses(self) -> np.ndarray:
         """The robots' start poses (N, 3), where :meth:`reset_positions` puts them."""
         return self._start.copy()
+
+    @property
+    def drives(self) -> DriveTable:
+        """What turns its robots' commands into body velocities: drive groups, wheelbases, velocity bounds."""
+        return self._drives
 
     @property
     def interval(self) -> float:
@@ -388,8 +424,8 @@ class _BatchShape:
 
     @classmethod
     def of(cls, sim: Simulation) -> _BatchShape:
-        return cls(sim.interval_us, tuple(r.settings.drive for r in sim.robots), sim._wheelbases.tobytes(),
-                   sim._bounds.tobytes())
+        return cls(sim.interval_us, tuple(r.settings.drive for r in sim.robots), sim._drives.wheelbases.tobytes(),
+                   sim._drives.bounds.tobytes())
 
 
 class SimulationBatch:
@@ -504,4 +540,4 @@ class SimulationBatch:
         self._state = (np.zeros((w, n, 3)), np.zeros((w, 2, n, 3)), np.zeros((w, n, 3)), np.zeros((w, n), dtype=bool),
                        np.zeros((w, n, 4)), np.zeros((w, n), dtype=bool), np.zeros((w, n, 3)))
         self._motion = (backend_for(sim.kernels).motion, group_by_drive([r.settings.drive for r in sim.robots] * w),
-                        np.tile(sim._wheelbases, w), np.tile(sim._bounds, (w, 1)))
+                        np.tile(sim._drives.wheelbases, w), np.tile(sim._drives.bounds, (w, 1)))

@@ -39,7 +39,7 @@ def warm() -> None:
         twins = [Simulation(world, seed=k, kernels="numba", threads=threads) for k in range(2)]
         SimulationBatch(2).step(twins, [0, 1])
     collision, sensing = sim.build_parts("numba")
-    fused = backend_for("numba").fused(collision, sensing.single_cast(), 1)
+    fused = backend_for("numba").fused(collision, sensing.single_cast(), 1, sim.drives)
     if fused is not None:  # its steps ran above; this also loads the cast into a grown robot layer
         fused.warm(sim.start_poses)
     big_batch = np.zeros((4096, 2))  # large enough for the parallel loop

@@ -155,3 +155,46 @@ bot( pose [4 2 0 45] )
             expected = np.stack([sim.scans[robot][0].ranges for robot in robots])
             assert same(first_laser_ranges(sim, np.array(robots)), expected), (step, robots)
     assert paths == {True, False}  # both ways were read
+
+
+@pytest.mark.parametrize(("discrete", "robots"), [(False, 1), (True, 1), (False, 3)])
+def test_a_step_in_one_call_is_the_step_part_by_part(discrete: bool, robots: int,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """A task's step in one compiled call (``Simulation.step_with``) gives every array that commanding, stepping
+    and scoring one after the other give, bit for bit, over episodes; with several robots also the steps whose
+    robot layer grew, whose call's cast was made again after it."""
+    from stage_sim.envs.scenarios import Scenario, ScenarioOptions
+    from stage_sim.envs.task import NavigationTask, TaskConfig
+    from stage_sim.envs.worlds import RobotBody
+
+    monkeypatch.setenv("STAGE_SIM_KERNELS", "numba")
+    options = ScenarioOptions(scenario="obstacles", n_robots=robots, n_obstacles=6, arena_size=6.0,
+                              body=RobotBody(laser_samples=24))
+    tasks = [NavigationTask(Scenario(options), TaskConfig(max_steps=40, discrete=discrete)) for _ in range(2)]
+    calls = {"one": 0, "grown": 0}
+    step_with = Simulation.step_with
+
+    def counted_step_with(sim: Simulation, kernel: object, arguments: tuple) -> bool:
+        held = step_with(sim, kernel, arguments)
+        calls["one" if held else "grown"] += 1
+        return held
+
+    monkeypatch.setattr(Simulation, "step_with", counted_step_with)
+    rng = np.random.default_rng(3)
+    fields = ("observations", "rewards", "terminated", "truncated", "arrived", "collided", "distance", "active")
+    for episode in range(6):
+        first = [task.reset(np.random.default_rng(episode)) for task in tasks]
+        assert same(*first)
+        while tasks[0].active.any():
+            size = (robots,) if discrete else (robots, 2)
+            actions = rng.integers(0, 15, size) if discrete else rng.uniform(-1, 2, size).astype(np.float32)
+            one = tasks[0].step(actions)
+            one = {name: np.copy(getattr(one, name)) for name in fields}  # the task's arrays, written again next step
+            with monkeypatch.context() as parts:
+                parts.setattr(Simulation, "fused_next", lambda sim: False)
+                apart = tasks[1].step(actions)
+            for name in fields:
+                assert same(one[name], getattr(apart, name)), (episode, name)
+        assert same(tasks[0].sim.true_poses, tasks[1].sim.true_poses)
+    assert calls["one"] > 100
+    assert calls["grown"] > 0 or robots == 1, calls

@@ -41,6 +41,17 @@ def test_body_velocities_match_the_reference(seed):
     steer = commands[:, 2]
     motion_kernels.body_velocities(commands, drives, wheelbases, bounds, np.cos(steer), np.sin(steer), out)
     assert out.tobytes() == body_velocity(commands, drives, wheelbases, bounds).tobytes()
+    # the fused step's twin: every drive in one call, the steering's cos and sin its own
+    fused = np.full((N, 3), np.nan)
+    motion_kernels.drive_velocities(commands, motion_kernels.drive_rows(drives), wheelbases, bounds, fused)
+    assert fused.tobytes() == out.tobytes()
+
+
+def test_the_fused_body_velocities_step_every_drive_of_the_registry():
+    """A compiled function calls each drive's twin by name: a drive added to the registry must be added there."""
+    assert tuple(DRIVES) == motion_kernels.STEPPED_DRIVES
+    rows = motion_kernels.drive_rows(group_by_drive(["car", "car", "diff"]))
+    assert [r.tolist() for r in rows] == [[2], [], [0, 1]]
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

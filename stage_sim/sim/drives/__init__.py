@@ -68,6 +68,16 @@ class DriveGroups(tuple):
         return made
 
 
+@dataclass(frozen=True)
+class DriveTable:
+    """What turns a world's commands into body velocities: its robots' drive groups, wheelbases (N,) and
+    ``velocity_bounds`` (N, 8) (a fused step reads them in its compiled call)."""
+
+    groups: DriveGroups
+    wheelbases: np.ndarray
+    bounds: np.ndarray
+
+
 def group_by_drive(names: Sequence[str]) -> DriveGroups:
     """The robots of each drive named in ``names`` (robot order), in registry order; absent drives get none."""
     names_array = np.array(names, dtype=object)
