@@ -61,6 +61,8 @@ class FreeSpace:
         """Cells around a blocking cell that can be within the reach of it."""
         self.origin = np.asarray(static.origin_xy, dtype=np.float64)
         self.width = static.shape[1]
+        self._compiled = sim.kernels == "numba"
+        """Whether draws test their candidates with the compiled twin (the same answers)."""
         padded = np.pad(self._blocked, 1, constant_values=True)  # the grid's edge blocks too
         if sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import clear_near
@@ -105,6 +107,7 @@ class FreeSpace:
         space.__dict__.pop("_rank", None)  # this space's, not the copy's
         space._bodies = list(static.bodies)
         space._blocked = blocked
+        space._compiled = sim.kernels == "numba"
         space._index_near(self, valid, boxes, self._pad + 1, sim.kernels == "numba", lost)
         return space
 
@@ -283,14 +286,23 @@ class FreeSpace:
     def draw(
         self, rng: np.random.Generator, avoid: np.ndarray, separation: float, region: int = 0,
         away_from: np.ndarray | None = None, min_distance: float = 0.0, excluded: frozenset[int] = frozenset(),
+        compiled: bool | None = None,
     ) -> np.ndarray:
         """One valid point at least ``separation`` from every row of ``avoid`` (M, 2), in ``region`` (0: any
-        but ``excluded``) and at least ``min_distance`` from ``away_from``; PlacementError if none exists."""
+        but ``excluded``) and at least ``min_distance`` from ``away_from``; PlacementError if none exists.
+        ``compiled``: test the candidates with the compiled twin (the same answers; default: when this space's
+        simulation runs the numba kernels)."""
         pool = self._pool(region, excluded)
         fits = _Fits(avoid, separation, away_from, min_distance)
         if len(pool):
             for _ in range(QUICK_BATCHES):
-                points = self.centres(pool.take(rng.integers(len(pool), size=BATCH)))
+                positions = rng.integers(len(pool), size=BATCH)
+                if self._compiled if compiled is None else compiled:
+                    point = self._first_fit(pool, positions, fits)
+                    if point is not None:
+                        return point
+                    continue
+                points = self.centres(pool.take(positions))
                 ok = fits(points)
                 if ok.any():
                     return points[np.argmax(ok)]
@@ -302,6 +314,19 @@ class FreeSpace:
             f"no room for a robot {separation:.2f} m from the others"
             + (f" and {min_distance:.2f} m from its start" if away_from is not None else "")
             + ": use fewer robots, a shorter goal distance or a larger world")
+
+    def _first_fit(self, pool: np.ndarray | _CellIndex, positions: np.ndarray, fits: _Fits) -> np.ndarray | None:
+        """The centre of the first candidate at ``positions`` of ``pool`` that ``fits``, or None: a batch of
+        :meth:`draw` in one compiled pass (:func:`~stage_sim.envs.free_space_kernels.first_fit`)."""
+        from stage_sim.envs.free_space_kernels import first_fit
+
+        cells, shift = (pool.base, pool.shift) if isinstance(pool, _CellIndex) else (pool, _NONE_REMOVED)
+        xs, ys = self._axes
+        away = _NO_POINT if fits.away_from is None else np.asarray(fits.away_from, dtype=np.float64)
+        point = np.empty(2)
+        found = first_fit(cells, shift, positions, self.width, xs, ys, fits.avoid, fits.separation, away,
+                          fits.min_distance, point)
+        return point if found >= 0 else None
 
     def starts_and_goals(
         self, rng: np.random.Generator, count: int, fixed: np.ndarray, min_goal_distance: float
@@ -363,6 +388,10 @@ def _windows(boxes: list[tuple[slice, slice]], margin: int, shape: tuple[int, ..
     return [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in spans]
 
 
+_NONE_REMOVED = np.zeros(0, dtype=np.int64)
+_NO_POINT = np.zeros(0)
+
+
 class _CellIndex:
     """Sorted flat cells: ``base``'s (sorted) less those at the sorted positions ``removed``, looked up without
     copying the rest (an episode's obstacles take a few thousand of some 340,000 valid centres, and a copy of
@@ -377,6 +406,15 @@ class _CellIndex:
 
     def __len__(self) -> int:
         return self._base.size - self._removed.size
+
+    @property
+    def base(self) -> np.ndarray:
+        return self._base
+
+    @property
+    def shift(self) -> np.ndarray:
+        """Per removed position, how many positions of the rest come before it (what :meth:`take` searches)."""
+        return self._shift
 
     def take(self, positions: np.ndarray) -> np.ndarray:
         return self._base[positions + np.searchsorted(self._shift, positions, side="right")]
@@ -418,7 +456,7 @@ class _Fits:
     PAIRS_AT_ONCE = 1 << 16
 
     def __init__(self, avoid: np.ndarray, separation: float, away_from: np.ndarray | None, min_distance: float):
-        self.avoid = np.asarray(avoid, dtype=np.float64).reshape(-1, 2)
+        self.avoid = np.ascontiguousarray(np.asarray(avoid, dtype=np.float64).reshape(-1, 2))
         self.separation = separation
         self.away_from = away_from
         self.min_distance = min_distance

@@ -238,3 +238,33 @@ def _row_major(cells, height, width):
                 j -= 1
             out[j + 1] = value
     return out
+
+
+@numba.njit(**_JIT)
+def first_fit(cells, shift, positions, width, xs, ys, avoid, separation, away_from, min_distance, out):
+    """The first of the candidate valid centres at ``positions`` among the pool of sorted flat ``cells`` less
+    those removed (``shift``: :class:`~stage_sim.envs.free_space._CellIndex`'s; empty: none removed) that keeps
+    ``separation`` from every row of ``avoid`` (M, 2) and ``min_distance`` from ``away_from`` (empty: no such
+    point): its centre into ``out`` (2,) and its index among the candidates, or -1. What a draw's batch of
+    candidates finds with numpy (:meth:`~stage_sim.envs.free_space.FreeSpace.draw`), the same arithmetic: the
+    candidates' cells looked up as ``take`` looks them up, their centres from the column and row centres ``xs``
+    and ``ys``, ``sqrt`` of the least ``dx² + dy²``. Why: some fifteen numpy calls on 64 candidates cost a draw
+    about 40 µs, and a reset of the obstacles scenario draws ten."""
+    for k in range(positions.size):
+        position = positions[k]
+        cell = cells[position + np.searchsorted(shift, position, side="right")]
+        x, y = xs[cell % width], ys[cell // width]
+        ok = True
+        if avoid.shape[0]:
+            nearest = np.inf
+            for j in range(avoid.shape[0]):
+                dx, dy = x - avoid[j, 0], y - avoid[j, 1]
+                nearest = min(nearest, dx * dx + dy * dy)
+            ok = math.sqrt(nearest) >= separation
+        if ok and away_from.size:
+            dx, dy = x - away_from[0], y - away_from[1]
+            ok = math.sqrt(dx * dx + dy * dy) >= min_distance
+        if ok:
+            out[0], out[1] = x, y
+            return k
+    return -1

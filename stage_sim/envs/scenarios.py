@@ -101,8 +101,9 @@ class Scenario:
             self._base_space = FreeSpace(base_sim, list(range(len(base_sim.robots))), 0.0)
         low, high = self.options.obstacle_size
         boxes = np.empty((self.options.n_obstacles, 5))
+        compiled = base_sim.starting_kernels() == "numba"  # the episode's kernels (the base stays on numpy)
         for i in range(len(boxes)):
-            boxes[i, :2] = self._base_space.draw(rng, boxes[:i, :2], high)
+            boxes[i, :2] = self._base_space.draw(rng, boxes[:i, :2], high, compiled=compiled)
             boxes[i, 2:4] = rng.uniform(low, high, 2)
             boxes[i, 4] = rng.uniform(-math.pi, math.pi)
         return self.source.add(self.base, obstacle_models(boxes, self.base.settings), bool(self.options.n_robots))

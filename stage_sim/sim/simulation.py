@@ -101,7 +101,7 @@ class Simulation:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         # Traced on the kernels the new simulation starts on: not this one's, which a base world that is never
         # stepped (an env's) keeps on numpy for good, its upgrade never adopted.
-        static = with_models(self.static, added, backend_for(self._starting_kernels()).trace)
+        static = with_models(self.static, added, backend_for(self.starting_kernels()).trace)
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
         sim._furnish(description, static, self._sensing)
         sim.reset(seed)
@@ -128,8 +128,8 @@ class Simulation:
         beams = sum(ranger.sensor.samples for robot in self.robots for ranger in robot.rangers)
         return upgrade_wanted(self._kernels_asked, beams)
 
-    def _starting_kernels(self) -> str:
-        """The kernels a simulation of this world starts on."""
+    def starting_kernels(self) -> str:
+        """The kernels a simulation of this world starts on (one :meth:`with_static_models` makes, too)."""
         return "numpy" if self._upgrade_wanted() else resolve_kernels(self._kernels_asked)
 
     def _furnish(self, description: WorldDescription, static: StaticRaster,
@@ -140,7 +140,7 @@ class Simulation:
         robots that start inside an obstacle."""
         self.description = description
         self.static = static
-        self.kernels = self._starting_kernels()
+        self.kernels = self.starting_kernels()
         self._upgrade = KernelUpgrade(self) if self._upgrade_wanted() else None
         self._collision, self._sensing = self.build_parts(self.kernels, rangers_of)
         self._motion = backend_for(self.kernels).motion

@@ -192,3 +192,38 @@ def test_the_compiled_free_space_is_scipys(options: ScenarioOptions) -> None:
         spaces = [FreeSpace(Simulation(world, kernels=kernels), [0], 0.1) for kernels in ("numpy", "numba")]
         np.testing.assert_array_equal(spaces[0].regions, spaces[1].regions)
         np.testing.assert_array_equal(spaces[0].cells, spaces[1].cells)
+
+
+def test_compiled_draws_are_the_numpy_draws() -> None:
+    """A draw tests its batches of candidates in one compiled pass on the compiled kernels: the same points, the
+    same failures and the same generator state as numpy's test, from whole pools and from pools less an episode's
+    obstacles' cells, in any region, away from a start or not, near crowds of points to avoid or not."""
+    scenario = Scenario(ScenarioOptions(scenario="obstacles", n_obstacles=6, arena_size=30.0, body=SMALL))
+    bases = {kernels: Simulation(scenario.base, kernels=kernels) for kernels in ("numpy", "numba")}
+    roots = {kernels: FreeSpace(base, [0], 0.1) for kernels, base in bases.items()}
+    for seed in range(10):  # an episode whose obstacles split no window: its pool is the base's less some cells
+        world = scenario.world(np.random.default_rng(seed), bases["numpy"])
+        spaces = {kernels: [root, root.with_world(Simulation(world, kernels=kernels))] for kernels, root in roots.items()}
+        if isinstance(spaces["numba"][1]._pool(0, frozenset()), _CellIndex):
+            break
+    assert isinstance(spaces["numba"][1]._pool(0, frozenset()), _CellIndex)
+    trial_rng = np.random.default_rng(5)
+    drawn = failed = 0
+    for trial in range(120):
+        kind = trial % 2
+        avoid = trial_rng.uniform(-15, 15, (int(trial_rng.integers(0, 40)), 2))
+        separation = float(trial_rng.choice([0.0, 0.4, 3.0, 12.0]))
+        away = trial_rng.uniform(-15, 15, 2) if trial % 3 else None
+        distance = float(trial_rng.choice([0.0, 2.0, 25.0]))
+        answers = []
+        for kernels in ("numpy", "numba"):
+            rng = np.random.default_rng(trial)
+            try:
+                point = spaces[kernels][kind].draw(rng, avoid, separation, 1 if trial % 5 == 0 else 0, away, distance)
+            except PlacementError:
+                point = None
+            answers.append((None if point is None else point.tobytes(), rng.bit_generator.state["state"]))
+        assert answers[0] == answers[1], trial
+        drawn += answers[0][0] is not None
+        failed += answers[0][0] is None
+    assert drawn > 30 and failed > 5
