@@ -170,7 +170,7 @@ class RangerSensing:
         ``body_cells``: the robots' raster the rays see, (cell, robot)
         (:meth:`~stage_sim.sim.collision.Contact.raster`), when the caller has it (else the bodies at ``poses``)."""
         now_us = round(time * 1e6)
-        if self.all_due(time):
+        if self.all_due(now_us):
             due = None
             self._mark_all_cast(now_us)
         else:
@@ -208,13 +208,14 @@ class RangerSensing:
         except KeyError:
             raise IndexError(f"robot {robot} has no ranger {ranger}") from None
 
-    def all_due(self, time: float) -> bool:
-        """Whether every ranger is due at ``time`` (the common step; always after :meth:`invalidate`)."""
-        return self._stale or round(time * 1e6) >= self._all_due_us
+    def all_due(self, now_us: int) -> bool:
+        """Whether every ranger is due at sim time ``now_us`` (µs; the common step; always after
+        :meth:`invalidate`)."""
+        return self._stale or now_us >= self._all_due_us
 
-    def none_due(self, time: float) -> bool:
-        """Whether no ranger is due at ``time`` (:meth:`sense` would cast nothing)."""
-        return not self._stale and round(time * 1e6) < self._next_due_us
+    def none_due(self, now_us: int) -> bool:
+        """Whether no ranger is due at sim time ``now_us`` (µs; :meth:`sense` would cast nothing)."""
+        return not self._stale and now_us < self._next_due_us
 
     def single_cast(self) -> SingleCast | None:
         """What a fused step (:class:`~stage_sim.sim.compiled.FusedStep`) needs to cast every ray in one call, when
@@ -237,10 +238,11 @@ class RangerSensing:
             uniform[:] = self._rng.uniform(-1.0, 1.0, len(noisy_rays))
             gauss[:] = self._rng.normal(0.0, 1.0, len(noisy_rays)) * sqrt_const
 
-    def record_all(self, published: np.ndarray, intensity: np.ndarray, time: float) -> None:
-        """Take the scans of every ranger cast at ``time`` by a fused step (when :meth:`all_due`): what
-        :meth:`sense` keeps of its own cast."""
-        self._mark_all_cast(round(time * 1e6))
+    def record_all(self, published: np.ndarray, intensity: np.ndarray, now_us: int) -> None:
+        """Take the scans of every ranger cast at sim time ``now_us`` (µs) by a fused step (when :meth:`all_due`):
+        what :meth:`sense` keeps of its own cast."""
+        self._mark_all_cast(now_us)
+        time = now_us / 1e6
         self._unpublished = published, intensity, time
         self.measured = MeasuredBeams(time, published, intensity, None, None)
 

@@ -236,9 +236,9 @@ class Simulation:
         if self.watchdog_timeout > 0:
             self._stop_silent_robots()
         layer = self._updates % 2
-        fused, now = self._fused is not None, self.sim_time
-        cast = fused and self._sensing.all_due(now)
-        if cast or (fused and self._sensing.none_due(now)):  # a fused step casts all rangers or none
+        fused, now_us = self._fused is not None, self.sim_time_us
+        cast = fused and self._sensing.all_due(now_us)
+        if cast or (fused and self._sensing.none_due(now_us)):  # a fused step casts all rangers or none
             self._step_fused(layer, dt, cast)
         else:
             self.velocities = self._body_velocities()
@@ -250,7 +250,7 @@ class Simulation:
         """Whether the next step is one compiled call that casts every ranger, with no watchdog to apply: a step
         :meth:`step_with` can make."""
         return (self._fused is not None and self.watchdog_timeout <= 0
-                and self._sensing.all_due((self.sim_time_us + self.interval_us) / MICROSECONDS))
+                and self._sensing.all_due(self.sim_time_us + self.interval_us))
 
     def step_with(self, kernel: Callable[..., int], arguments: tuple) -> bool:
         """:meth:`step`, when :meth:`fused_next`, with its compiled call made by ``kernel``, a compiled function
@@ -291,7 +291,7 @@ class Simulation:
             fused.poses, fused.stalled, fused.odometry, fused.layers, fused.velocities
         self._updates += 1
         if cast:
-            self._sensing.record_all(*fused.scans, self.sim_time)
+            self._sensing.record_all(*fused.scans, self.sim_time_us)
         return fused
 
     def _step_by_roles(self, layer: int, dt: float) -> None:
@@ -464,7 +464,7 @@ class SimulationBatch:
         for sim, slot in zip(sims, slots, strict=True):
             member = self._members[slot]
             if ((member is not None and member[0] is sim and member[1] is sim._fused) or self._admit(sim, slot)) \
-                    and sim._sensing.all_due((sim.sim_time_us + sim.interval_us) / MICROSECONDS):
+                    and sim._sensing.all_due(sim.sim_time_us + sim.interval_us):
                 joined.append(sim)
                 joined_slots.append(slot)
             else:  # not a fused step that casts every ranger (as Simulation.step would make it), or of another shape
@@ -511,7 +511,7 @@ class SimulationBatch:
             given_all[slot] = (*given, sim.odom_errors, sim.commands)
             sim.velocities = velocities[slot]
             sim._updates += 1
-            sim._sensing.record_all(published[slot], intensity[slot], sim.sim_time)
+            sim._sensing.record_all(published[slot], intensity[slot], sim.sim_time_us)
         self._state = (result.poses, result.layers, result.odometry, result.stalled, errors, uses_odom, commands)
         self.poses, self.stalled, self.velocities, self.ranges = result.poses, result.stalled, velocities, published
 
