@@ -203,7 +203,8 @@ def test_compiled_draws_are_the_numpy_draws() -> None:
     roots = {kernels: FreeSpace(base, [0], 0.1) for kernels, base in bases.items()}
     for seed in range(10):  # an episode whose obstacles split no window: its pool is the base's less some cells
         world = scenario.world(np.random.default_rng(seed), bases["numpy"])
-        spaces = {kernels: [root, root.with_world(Simulation(world, kernels=kernels))] for kernels, root in roots.items()}
+        spaces = {kernels: [root, root.with_world(Simulation(world, kernels=kernels))]
+                  for kernels, root in roots.items()}
         if isinstance(spaces["numba"][1]._pool(0, frozenset()), _CellIndex):
             break
     assert isinstance(spaces["numba"][1]._pool(0, frozenset()), _CellIndex)
