@@ -124,10 +124,13 @@ class RangerSensing:
         self._latest: list[list[Scan]] = [[] for _ in self._robots]
         self._unpublished: tuple[np.ndarray, np.ndarray, float] | None = None
         """A fused step's cast of every ranger (float32 ranges, intensities, time) not made into scans yet."""
-        self.measured: MeasuredBeams | None = None
-        """The beams of the last sensing that cast any (None before the first)."""
+        self._unmeasured: tuple[np.ndarray, np.ndarray, float] | None = None
+        """The same cast, not made into :attr:`measured` yet."""
+        self._measured: MeasuredBeams | None = None
         self._rng = np.random.default_rng()
         self._last_us = np.zeros(len(self._rangers), dtype=np.int64)
+        self._all_cast_us: int | None = None
+        """When the last cast of every ranger was, while ``_last_us`` does not hold it yet (:meth:`_last_casts`)."""
         self._all_due_us = 0
         """From this sim time on every ranger is due (the common step, told without an array per ranger)."""
         self._next_due_us = 0
@@ -142,12 +145,30 @@ class RangerSensing:
         """Carry on where ``previous`` (the same rangers on other kernels) stands: its latest scans, schedule,
         pending re-scan and random generator."""
         self._latest = previous.latest
-        self.measured = previous.measured
-        self._last_us = previous._last_us.copy()
+        self._measured, self._unmeasured = previous.measured, None
+        self._last_us = previous._last_casts().copy()
+        self._all_cast_us = None
         self._all_due_us = previous._all_due_us
         self._next_due_us = previous._next_due_us
         self._stale = previous._stale
         self._rng = previous._rng
+
+    @property
+    def measured(self) -> MeasuredBeams | None:
+        """The beams of the last sensing that cast any (None before the first); those of a fused step's cast are
+        wrapped when first read (a run that reads none, an env's, wraps none)."""
+        if self._unmeasured is not None:
+            published, intensity, time = self._unmeasured
+            self._unmeasured = None
+            self._measured = MeasuredBeams(time, published, intensity, None, None)
+        return self._measured
+
+    def _last_casts(self) -> np.ndarray:
+        """When each ranger last cast (µs), brought up to date after the casts of every ranger."""
+        if self._all_cast_us is not None:
+            self._last_us.fill(self._all_cast_us)  # a slice assignment costs twice as much
+            self._all_cast_us = None
+        return self._last_us
 
     @property
     def latest(self) -> list[list[Scan]]:
@@ -175,7 +196,7 @@ class RangerSensing:
             self._mark_all_cast(now_us)
         else:
             self._stale = False
-            due = (now_us - self._last_us) >= self._interval_us
+            due = (now_us - self._last_casts()) >= self._interval_us
             if not due.any():
                 return
             self._last_us[due] = now_us
@@ -198,7 +219,7 @@ class RangerSensing:
             if self._noisy else ranges
         published = noisy.astype(np.float32)  # one conversion; each scan holds views of its own beams
         self._publish(range(len(self._rangers)) if due is None else np.flatnonzero(due), published, intensity, time)
-        self.measured = MeasuredBeams(time, published, intensity, due, ray_due)
+        self._measured, self._unmeasured = MeasuredBeams(time, published, intensity, due, ray_due), None
 
     def beams_of(self, robot: int, ranger: int) -> slice:
         """Where the beams of ranger ``ranger`` of robot ``robot`` lie among every ranger's
@@ -242,14 +263,12 @@ class RangerSensing:
         """Take the scans of every ranger cast at sim time ``now_us`` (µs) by a fused step (when :meth:`all_due`):
         what :meth:`sense` keeps of its own cast."""
         self._mark_all_cast(now_us)
-        time = now_us / 1e6
-        self._unpublished = published, intensity, time
-        self.measured = MeasuredBeams(time, published, intensity, None, None)
+        self._unpublished = self._unmeasured = published, intensity, now_us / 1e6
 
     def _mark_all_cast(self, now_us: int) -> None:
         """Every ranger cast at ``now_us``: the next all-due step is a longest interval away."""
         self._stale = False
-        self._last_us.fill(now_us)  # a slice assignment costs twice as much
+        self._all_cast_us = now_us  # written into the last casts when they are read
         self._all_due_us = now_us + self._longest_us
         self._next_due_us = now_us + self._shortest_us
 
