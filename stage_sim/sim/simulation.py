@@ -231,20 +231,7 @@ class Simulation:
 
     def step(self) -> None:
         """Advance the world by one ``interval_sim``."""
-        self.sim_time_us += self.interval_us
-        dt = self.interval_us / MICROSECONDS
-        if self.watchdog_timeout > 0:
-            self._stop_silent_robots()
-        layer = self._updates % 2
-        fused, now_us = self._fused is not None, self.sim_time_us
-        cast = fused and self._sensing.all_due(now_us)
-        if cast or (fused and self._sensing.none_due(now_us)):  # a fused step casts all rangers or none
-            self._step_fused(layer, dt, cast)
-        else:
-            self.velocities = self._body_velocities()
-            self._step_by_roles(layer, dt)
-        if self._upgrade is not None:
-            self._adopt(self._upgrade.poll())
+        self._advance(None, ())
 
     def fused_next(self) -> bool:
         """Whether the next step is one compiled call that casts every ranger, with no watchdog to apply: a step
@@ -260,12 +247,32 @@ class Simulation:
 
         Returns whether the call's view of the scans holds. It does not, rarely, when the robot layer was too
         small for the cast: the call's own cast is then skipped and the rays are cast again into a grown layer
-        after it (:attr:`measured_beams` has them)."""
-        self.sim_time_us += self.interval_us
-        result = self._step_fused(self._updates % 2, self.interval_us / MICROSECONDS, True, kernel, arguments)
+        after it (:attr:`measured_beams` has them). ValueError, the step not made, when not :meth:`fused_next`."""
+        if self.watchdog_timeout > 0:
+            raise ValueError("step_with makes the steps fused_next() announces: this one applies a watchdog")
+        return not self._advance(kernel, arguments).grown
+
+    def _advance(self, kernel: Callable[..., int] | None, arguments: tuple) -> FusedResult | None:
+        """One step (:meth:`step`; its compiled call ``kernel``'s when given, :meth:`step_with`); the fused step's
+        result, None when it stepped role by role."""
+        fused, now_us = self._fused is not None, self.sim_time_us + self.interval_us
+        cast = fused and self._sensing.all_due(now_us)
+        if kernel is not None and not cast:
+            raise ValueError("step_with makes the steps fused_next() announces: this one is not one call")
+        self.sim_time_us = now_us
+        dt = self.interval_us / MICROSECONDS
+        if self.watchdog_timeout > 0:
+            self._stop_silent_robots()
+        layer = self._updates % 2
+        result = None
+        if cast or (fused and self._sensing.none_due(now_us)):  # a fused step casts all rangers or none
+            result = self._step_fused(layer, dt, cast, kernel, arguments)
+        else:
+            self.velocities = self._body_velocities()
+            self._step_by_roles(layer, dt)
         if self._upgrade is not None:
             self._adopt(self._upgrade.poll())
-        return not result.grown
+        return result
 
     def _stop_silent_robots(self) -> None:
         """The watchdog: zero the commands of the robots not commanded for ``watchdog_timeout``. Commands only

@@ -415,3 +415,25 @@ def test_a_world_that_is_not_this_one_plus_static_models_is_built_from_scratch()
     assert made.true_poses.tolist() == Simulation(other, seed=0).true_poses.tolist()
 
 
+
+
+def test_a_step_with_a_callers_kernel_is_refused_unless_it_is_one_compiled_call() -> None:
+    """``step_with`` makes only the steps ``fused_next`` announces; any other is refused before it starts."""
+    from stage_sim.sim import fused_kernels
+
+    robot = "bot( pose [2 2 0 0] )\n"
+    for kernels, watchdog in (("numpy", 0.0), ("numba", 5.0)):
+        sim = Simulation(world(robot), seed=0, watchdog_timeout=watchdog, kernels=kernels)
+        assert not sim.fused_next()
+        with pytest.raises(ValueError, match="fused_next"):
+            sim.step_with(fused_kernels.commanded_step, ())
+        assert sim.sim_time_us == 0
+    sim = Simulation(world(robot), seed=0, kernels="numba")
+    sim.set_velocity(0, 0.5, 0.0, 0.2)
+    assert sim.fused_next()
+    assert sim.step_with(fused_kernels.commanded_step, ())
+    twin = Simulation(world(robot), seed=0, kernels="numba")
+    twin.set_velocity(0, 0.5, 0.0, 0.2)
+    twin.step()
+    assert sim.true_poses.tobytes() == twin.true_poses.tobytes()
+    assert sim.measured_beams.ranges.tobytes() == twin.measured_beams.ranges.tobytes()
