@@ -82,7 +82,7 @@ bench: setup
 	$(call bench_run,worlds,python benchmarks/worlds.py --worlds rl --threads 2 $(call pick,,--seconds 2))
 	$(call bench_run,jump_chain,taskset -c 0 python benchmarks/jump_chain.py)
 	$(call bench_run,bags,python benchmarks/bags.py $(call pick,,--duration 600 --wander-duration 60 --repeat 1))
-	$(call bench_run,envs,taskset -c 0 python benchmarks/envs.py $(call pick,,--seconds 3 --episodes 3))
+	$(call bench_run,envs,taskset -c 0 python benchmarks/envs.py --worlds 16 64 $(call pick,,--seconds 3 --episodes 3))
 	$(call bench_run,fidelity,python benchmarks/fidelity.py)
 	$(call bench_run,wander_speed,taskset -c 0 python benchmarks/wander_speed.py $(call pick,,--steps 300))
 	$(call bench_run,wander_sweep,python benchmarks/wander_sweep.py --core --world rooms.world $(call pick,--seeds 20 --minutes 30,--seeds 2 --minutes 30 --jobs 1))
