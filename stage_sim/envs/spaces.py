@@ -192,10 +192,16 @@ class ActionMap:
 
     def commands(self, actions: np.ndarray) -> np.ndarray:
         """(A, 2) commands (v, ω) from one action per agent; continuous ones are clamped into the bounds."""
+        chosen = self.arrays(actions)
         if self.discrete:
-            chosen = np.asarray(actions, dtype=np.int64).reshape(-1)
             return self.table[np.arange(len(chosen)), chosen]
-        return np.clip(np.asarray(actions, dtype=np.float64).reshape(-1, 2), self.low, self.high)
+        return np.clip(chosen, self.low, self.high)
+
+    def arrays(self, actions: np.ndarray) -> np.ndarray:
+        """One action per agent as an array: (A,) int64 table rows, or (A, 2) float64 (v, ω) not yet clamped."""
+        if self.discrete:
+            return np.asarray(actions, dtype=np.int64).reshape(-1)
+        return np.asarray(actions, dtype=np.float64).reshape(-1, 2)
 
     def nearest(self, commands: np.ndarray) -> np.ndarray:
         """The discrete action closest to each agent's wanted (v, ω), for scripted policies."""

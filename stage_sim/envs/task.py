@@ -149,10 +149,10 @@ def compiled_command_agents(sim: Simulation, agents: np.ndarray, action_map: Act
     writes."""
     kernels = _kernels()
     if action_map.discrete:
-        kernels.discrete_commands(action_map.table, np.asarray(actions, dtype=np.int64).reshape(-1), active, agents,
+        kernels.discrete_commands(action_map.table, action_map.arrays(actions), active, agents,
                                   sim.commands, sim.last_command_us, sim.sim_time_us)
     else:
-        kernels.continuous_commands(np.asarray(actions, dtype=np.float64).reshape(-1, 2), action_map.low,
+        kernels.continuous_commands(action_map.arrays(actions), action_map.low,
                                     action_map.high, active, agents, sim.commands, sim.last_command_us,
                                     sim.sim_time_us)
 
@@ -171,26 +171,20 @@ def compiled_finish_step(
 class _CompiledStep:
     """A task's whole step in one compiled call (:mod:`stage_sim.envs.step_kernels`' ``continuous_step`` or
     ``discrete_step``, through :meth:`~stage_sim.sim.simulation.Simulation.step_with`): the tables it reads and
-    writes, and the step results' arrays, which are views of them."""
+    writes, and the step results' arrays, which are they or views of them (made once)."""
 
     def __init__(self, task: NavigationTask) -> None:
         kernels = _kernels()
         observer, actions, count = task._observer, task.actions, len(task.agents)
         self.kernel = kernels.discrete_step if actions.discrete else kernels.continuous_step
-        self.discrete = actions.discrete
-        self.rewards, self.distance, self.flags = np.zeros(count), np.zeros(count), np.zeros((5, count), dtype=bool)
+        self.rewards, self.distance, flags = np.zeros(count), np.zeros(count), np.zeros((5, count), dtype=bool)
+        self.flags = tuple(flags)  # terminated, truncated, arrived, collided, was active
         self.tables = kernels.task_tables(
             task._agent_rows, np.array([task.sim.beams_of(agent).start for agent in task.agents], dtype=np.int64),
             observer.range_scale, observer.history, observer.tail_low, observer.tail_high,
             task.config.reward.weights, actions.low, actions.high, actions.table, task.active, self.distance,
-            self.rewards, self.flags)
+            self.rewards, flags)
         self.size = observer.layout.size
-
-    def actions(self, actions: np.ndarray) -> np.ndarray:
-        """The agents' actions as its kernel takes them: (A,) int64 or (A, 2) float64."""
-        if self.discrete:
-            return np.asarray(actions, dtype=np.int64).reshape(-1)
-        return np.asarray(actions, dtype=np.float64).reshape(-1, 2)
 
 
 class NavigationTask:
@@ -251,10 +245,9 @@ class NavigationTask:
         if compiled and sim.fused_next():
             whole = self._compiled or self._compile()
             rows = np.empty((len(agents), whole.size), dtype=np.float32)
-            if sim.step_with(whole.kernel, (whole.tables, whole.actions(actions), sim.last_command_us,
+            if sim.step_with(whole.kernel, (whole.tables, self.actions.arrays(actions), sim.last_command_us,
                                             sim.sim_time_us, self.goals, at_limit, rows)):
-                flags = whole.flags
-                return StepResult(rows, whole.rewards, flags[0], flags[1], flags[2], flags[3], self.distance, flags[4])
+                return StepResult(rows, whole.rewards, *whole.flags[:4], self.distance, whole.flags[4])
         else:
             (compiled_command_agents if compiled else command_agents)(sim, agents, self.actions, actions, self.active)
             sim.step()
