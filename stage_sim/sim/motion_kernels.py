@@ -55,7 +55,7 @@ def drive_velocities(commands, rows, wheelbases, bounds, out):
     """:func:`body_velocities` in one compiled call (a fused step's first part), ``rows`` from :func:`drive_rows`:
     the cos and sin of the steering angle are libm's, which are numpy's (``tests/sim/test_trigonometry.py``),
     worked out for the robots of the one steered drive (``car``) only."""
-    n = commands.shape[0]
+    n = commands.shape[0] if rows[2].size else 0  # no car: no steering to work out
     cos_steer, sin_steer = np.empty(n), np.empty(n)
     for i in rows[2]:
         cos_steer[i], sin_steer[i] = math.cos(commands[i, 2]), math.sin(commands[i, 2])
