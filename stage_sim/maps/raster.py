@@ -259,10 +259,18 @@ def with_models(raster: StaticRaster, models: list[Model],
 def _moved(body: StaticBody, shift: np.ndarray, width: int,
            frame: tuple[float, tuple[float, float], tuple[int, int]]) -> StaticBody:
     """``body`` on a grown grid (``frame``) whose cell ``-shift`` (columns, rows) was the old grid's (0, 0),
-    ``width`` the old grid's columns: its outline cells keep their row-major order, so they stay sorted."""
-    rows, cols = np.divmod(body.outline, width)
-    outline = (rows + shift[1]) * frame[2][1] + cols + shift[0]
-    return replace(body, outline=outline, frame=frame)
+    ``width`` the old grid's columns: its outline cells keep their row-major order, so they stay sorted. Its
+    filled footprint, when made, moves with it: the same world cells, not filled again (a free space of every
+    episode whose obstacles grow the grid asked for the arena's walls' footprints anew, 3 ms of its reset)."""
+
+    def move(flat: np.ndarray) -> np.ndarray:
+        rows, cols = np.divmod(flat, width)
+        return (rows + shift[1]) * frame[2][1] + cols + shift[0]
+
+    moved = replace(body, outline=move(body.outline), frame=frame)
+    if "cells" in body.__dict__:
+        moved.__dict__["cells"] = move(body.cells)  # the cached_property's slot: what reading it would store
+    return moved
 
 
 def _static_bodies(

@@ -73,6 +73,31 @@ def test_an_episode_world_extends_its_base_tiles_into_those_of_a_fresh_raster() 
         np.testing.assert_array_equal(extended.bits, built.bits)
 
 
+def test_an_episode_world_that_grows_the_grid_moves_the_filled_footprints_it_had() -> None:
+    """A box reaching past the base grid grows it: the base bodies' outlines and the filled footprints already
+    made move onto the new grid (the same world cells a fill on the new grid gives), not filled again."""
+    from dataclasses import replace
+
+    from stage_sim.maps.raster import with_models
+    from stage_sim.worldfile.loader import load_world_text as load
+
+    base_text = ("resolution 0.05\nmodel( size [8 0.1 1] pose [0 -3 0 0] obstacle_return 1 )\n"
+                 "model( size [0.1 6 0.5] pose [3.9 0 0 0] obstacle_return 1 )\n")
+    base = build_static_raster(load(base_text, "base.world"))
+    base.filled_collision_layer(0.0, 0.4)  # what placement asks of the base world
+    boxes = load(base_text + "model( size [0.9 0.9 1] pose [4.1 2.5 0 30] obstacle_return 1 )\n",
+                 "boxes.world").models[2:]
+    episode = with_models(base, boxes)
+    assert episode.shape[1] > base.shape[1] and episode.extends is None
+    for moved in episode.bodies[:2]:
+        assert "cells" in moved.__dict__
+        np.testing.assert_array_equal(moved.cells, replace(moved).cells)  # a copy fills its own
+    fresh = np.zeros(episode.shape, dtype=bool)
+    for body in episode.bodies:
+        fresh.ravel()[replace(body).cells] = True
+    np.testing.assert_array_equal(episode.filled_collision_layer(0.0, 0.4), fresh)
+
+
 def test_intensities_are_the_last_body_s_and_a_single_value_stores_no_cells() -> None:
     values = CellValues.last_wins(np.array([7, 3, 7, 9]), np.array([0.5, 1.0, 2.0, 1.0]))
     np.testing.assert_array_equal(values.at(np.array([3, 7, 9])), [1.0, 2.0, 1.0])
