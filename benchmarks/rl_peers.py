@@ -5,10 +5,15 @@ The scenario (issue #34): diff-drive robots of radius 0.2 m, each with a 512-bea
 ±π/2 rad/s) for every robot at every step; 1, 10 and 100 robots. Simulators and the API measured:
 
 * ``stage_sim env``: ``stage_sim/Navigate-v0`` (1 robot) or ``NavigateParallelEnv`` (10, 100), the
-  obstacles scenario; episodes that end are reset (resets count in the time);
+  obstacles scenario, whose boxes are drawn anew in every episode; episodes that end are reset (resets count
+  in the time);
+* ``stage_sim env, fixed boxes``: the same env on a world file holding the boxes the peers get (the
+  ``"random"`` scenario: new starts and goals every episode, the boxes where they are), as navground's env
+  keeps the boxes of its scenario from one episode to the next;
 * ``stage_sim vector env`` (1-robot rows only): ``NavigateVectorEnv`` of 64 such one-robot worlds stepped
   together (its worlds' steps in one compiled call, autoresets counted in the time), every world's robot an
-  agent: what an RL user running N copies of the one-robot env gets from stage_sim;
+  agent: what an RL user running N copies of the one-robot env gets from stage_sim; ``stage_sim vector env,
+  fixed boxes`` the same on the peers' boxes;
 * ``stage_sim core``: the same world's ``Simulation.step`` (commands written, one step, no env), only that
   timed; the world is reset through the env (untimed) when the env would end the episode (every robot has
   collided, or the step limit), so that the core steps robots in open space as the env's do, not resting
@@ -61,12 +66,13 @@ DT = 0.1
 V_MAX, W_MAX = 1.0, math.pi / 2
 #: Case → the venv (under --venvs) whose interpreter runs it; None: this interpreter (stage_sim's venv).
 CASES: dict[str, str | None] = {
-    "stage_sim env": None, "stage_sim vector env": None, "stage_sim core": None, "stage_sim rays": None,
+    "stage_sim env": None, "stage_sim env, fixed boxes": None, "stage_sim vector env": None,
+    "stage_sim vector env, fixed boxes": None, "stage_sim core": None, "stage_sim rays": None,
     "navground env": "navground", "navground world": "navground",
     "irsim-x": "irsim-x", "ir-sim": "ir-sim",
 }
 #: Cases of one-robot worlds only (run in the 1-robot rows).
-ONE_ROBOT_CASES = {"stage_sim vector env"}
+ONE_ROBOT_CASES = {"stage_sim vector env", "stage_sim vector env, fixed boxes"}
 #: The worlds of the vector env case.
 VECTOR_WORLDS = 64
 #: The probe of ``lidar_sees_robots``: robot 1 a metre straight ahead of robot 0, nothing else around.
@@ -155,14 +161,34 @@ STAGE_OPTIONS = {"scenario": "obstacles", "n_obstacles": BOXES, "obstacle_size":
                  "resolution": 0.05}
 
 
+@contextlib.contextmanager
+def stage_options(fixed: bool, seed: int) -> Iterator[dict[str, Any]]:
+    """The envs' keyword arguments: the obstacles scenario, or (``fixed``) the ``"random"`` scenario of a world
+    file holding the arena and the boxes the peers get from ``seed``, for as long as the env is being built (it
+    reads the file then)."""
+    if not fixed:
+        yield STAGE_OPTIONS
+        return
+    import tempfile
+
+    from stage_sim.envs.worlds import arena_text, obstacles_text
+
+    with tempfile.TemporaryDirectory() as folder:
+        world = Path(folder) / "fixed_boxes.world"
+        world.write_text(arena_text(ARENA, STAGE_OPTIONS["resolution"]) + obstacles_text(layout(0, seed)[0]))
+        yield {"scenario": "random", "world": world}
+
+
 class StageEnv(EnvRunner):
+    fixed = False  #: the peers' boxes, which stay put, instead of new ones every episode
+
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.envs import NavigateEnv, NavigateParallelEnv
 
-        options = STAGE_OPTIONS
         self.agents = robots
         self.single = robots == 1
-        self.env = NavigateEnv(**options) if self.single else NavigateParallelEnv(n_robots=robots, **options)
+        with stage_options(self.fixed, seed) as options:
+            self.env = NavigateEnv(**options) if self.single else NavigateParallelEnv(n_robots=robots, **options)
         self.row_of = int if self.single else {name: k for k, name in enumerate(self.env.possible_agents)}.__getitem__
         self.env.reset(seed=seed)
         self.sees_robots = stage_sees_robots()
@@ -171,14 +197,21 @@ class StageEnv(EnvRunner):
         return self.step_env(action.astype(np.float32), self.row_of)
 
 
+class StageEnvFixed(StageEnv):
+    fixed = True
+
+
 class StageVectorEnv(Runner):
     """``NavigateVectorEnv`` of :data:`VECTOR_WORLDS` one-robot worlds (the obstacles scenario, next-step
     autoreset): a step advances every world, and the worlds reset by it are not live."""
 
+    fixed = False
+
     def __init__(self, robots: int, seed: int) -> None:
         from stage_sim.envs import NavigateVectorEnv
 
-        self.env = NavigateVectorEnv(VECTOR_WORLDS, **STAGE_OPTIONS)
+        with stage_options(self.fixed, seed) as options:
+            self.env = NavigateVectorEnv(VECTOR_WORLDS, **options)
         self.env.reset(seed=seed)
         self.agents = VECTOR_WORLDS
         self.sees_robots = stage_sees_robots()
@@ -186,6 +219,10 @@ class StageVectorEnv(Runner):
     def step(self, action: np.ndarray) -> int:
         infos = self.env.step(action.astype(np.float32))[4]
         return int(infos["_arrived"].sum())  # the worlds that stepped (the others were reset)
+
+
+class StageVectorEnvFixed(StageVectorEnv):
+    fixed = True
 
 
 class StageCore(StageEnv):
@@ -430,7 +467,8 @@ def irsim_sees_robots() -> bool:
 
 
 RUNNERS: dict[str, type[Runner]] = {
-    "stage_sim env": StageEnv, "stage_sim vector env": StageVectorEnv, "stage_sim core": StageCore,
+    "stage_sim env": StageEnv, "stage_sim env, fixed boxes": StageEnvFixed, "stage_sim vector env": StageVectorEnv,
+    "stage_sim vector env, fixed boxes": StageVectorEnvFixed, "stage_sim core": StageCore,
     "stage_sim rays": StageRays, "navground env": NavgroundEnv,
     "navground world": NavgroundWorld, "irsim-x": IrSim, "ir-sim": IrSim,
 }

@@ -91,11 +91,21 @@ def world_centre(description: WorldDescription) -> tuple[float, float]:
     return (float(low_x + high_x) / 2, float(low_y + high_y) / 2)
 
 
+def obstacles_text(boxes: np.ndarray) -> str:
+    """Static boxes, one row (x, y, width, depth, yaw) each, as world text (4 decimals, yaw in degrees): a world
+    whose boxes stay put from one episode to the next (the ``"random"`` scenario of a file holding them), where
+    the ``"obstacles"`` scenario makes the same models anew at every reset (:func:`obstacle_models`)."""
+    rows = enumerate(np.reshape(boxes, (-1, 5)).tolist())
+    return "".join(
+        f'model( name "obstacle_{i}" size [{w:.4f} {d:.4f} 1] pose [{x:.4f} {y:.4f} 0 {math.degrees(a):.4f}] '
+        f'color "{OBSTACLE_COLOR}" obstacle_return 1 )\n' for i, (x, y, w, d, a) in rows)
+
+
 def obstacle_models(boxes: np.ndarray, settings: WorldSettings) -> list[Model]:
     """Static boxes, one row (x, y, width, depth, yaw) each, as ordinary obstacle models: the models the loader
-    makes of ``model( name "obstacle_<i>" size [w d 1] pose [x y 0 yaw°] color "DarkSlateGray"
-    obstacle_return 1 )`` appended to the world's text, without writing or parsing it (a reset builds one
-    world per episode). Like that text they hold 4 decimals (yaw in degrees) and are read in the world's units."""
+    makes of their :func:`obstacles_text` appended to the world's text, without writing or parsing it (a reset
+    builds one world per episode). Like that text they hold 4 decimals (yaw in degrees) and are read in the
+    world's units."""
     length, angle = settings.unit_length, settings.unit_angle
     color = x11_color(OBSTACLE_COLOR)
     models = []

@@ -24,7 +24,8 @@ TINY = {
     "raycast": ["--poses", "4", "--robots", "20", "--repeats", "1"],
     # The stage_sim rows only: the peers' venvs (make bench-peers) need not be there.
     "rl_peers": ["--robots", "1", "2", "--seconds", "0.1", "--reps", "1", "--cases", "stage_sim env",
-                 "stage_sim vector env", "stage_sim core", "stage_sim rays"],
+                 "stage_sim env, fixed boxes", "stage_sim vector env", "stage_sim vector env, fixed boxes",
+                 "stage_sim core", "stage_sim rays"],
     "simulate": ["--robots", "1", "2", "--seconds", "0.5"],
     "stageros": ["--seconds", "1"],
     # No numba compile (a cold cache takes half a minute) and no 1000-robot world (the corpus tests start it).

@@ -14,7 +14,7 @@ from stage_sim.envs import RobotBody
 from stage_sim.envs.free_space import FreeSpace, PlacementError, _CellIndex
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.task import NavigationTask, TaskConfig
-from stage_sim.envs.worlds import arena_text, obstacle_models
+from stage_sim.envs.worlds import arena_text, obstacle_models, obstacles_text
 from stage_sim.maps.polygon_raster import outline_points
 from stage_sim.sim.simulation import Simulation
 from stage_sim.worldfile.loader import load_world_text
@@ -166,10 +166,7 @@ def test_obstacle_models_are_the_models_the_loader_makes_of_their_text(units: st
     boxes = np.column_stack([np.random.default_rng(3).uniform(-14, 14, (40, 2)),
                              np.random.default_rng(4).uniform(0.3, 1.0, (40, 2)),
                              np.random.default_rng(5).uniform(-math.pi, math.pi, 40)])
-    text = "".join(
-        f'model( name "obstacle_{i}" size [{w:.4f} {d:.4f} 1] pose [{x:.4f} {y:.4f} 0 {math.degrees(a):.4f}] '
-        'color "DarkSlateGray" obstacle_return 1 )\n' for i, (x, y, w, d, a) in enumerate(boxes))
-    parsed = load_world_text(units + arena_text(30.0) + text, "arena.world")
+    parsed = load_world_text(units + arena_text(30.0) + obstacles_text(boxes), "arena.world")
     made = obstacle_models(boxes, parsed.settings)
     assert len(made) == len(boxes)
     for mine, theirs in zip(made, parsed.models[4:], strict=True):
