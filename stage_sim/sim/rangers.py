@@ -368,8 +368,8 @@ class RangerSensing:
 
     def _tables_by_height(self, robots: list[RobotSpec]) -> list[_BeamTable]:
         """The rays of each height with what they read of their rangers and robots: the robots' alone, made once
-        and shared by every world these rangers are moved over (:meth:`over`). A vector env's worlds then read
-        one copy (20 KB for 512 beams) instead of each its own, which its compiled step walked cache-cold."""
+        and shared by every world these rangers are moved over (:meth:`over`): a vector env's worlds hold one
+        copy (20 KB for 512 beams), not one each, and a reset slices none."""
         returns = np.array([r.model.ranger_return for r in robots], dtype=np.float32)
         tables = []
         for height in np.unique(self._ray_height):
