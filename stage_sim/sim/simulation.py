@@ -431,8 +431,8 @@ class _BatchShape:
 
     @classmethod
     def of(cls, sim: Simulation) -> _BatchShape:
-        return cls(sim.interval_us, tuple(r.settings.drive for r in sim.robots), sim._drives.wheelbases.tobytes(),
-                   sim._drives.bounds.tobytes())
+        return cls(sim.interval_us, tuple(r.settings.drive for r in sim.robots), sim.drives.wheelbases.tobytes(),
+                   sim.drives.bounds.tobytes())
 
 
 class SimulationBatch:
@@ -547,4 +547,4 @@ class SimulationBatch:
         self._state = (np.zeros((w, n, 3)), np.zeros((w, 2, n, 3)), np.zeros((w, n, 3)), np.zeros((w, n), dtype=bool),
                        np.zeros((w, n, 4)), np.zeros((w, n), dtype=bool), np.zeros((w, n, 3)))
         self._motion = (backend_for(sim.kernels).motion, group_by_drive([r.settings.drive for r in sim.robots] * w),
-                        np.tile(sim._drives.wheelbases, w), np.tile(sim._drives.bounds, (w, 1)))
+                        np.tile(sim.drives.wheelbases, w), np.tile(sim.drives.bounds, (w, 1)))
