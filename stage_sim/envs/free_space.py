@@ -49,6 +49,8 @@ class FreeSpace:
     def __init__(self, sim: Simulation, robots: list[int], margin: float) -> None:
         static = sim.static
         static.grid.check_dense("placing robots in free space (a distance transform of the whole world)")
+        self._static = static
+        """The raster this is the free space of."""
         self._robots = robots
         self._margin = margin
         self._bodies = list(static.bodies)
@@ -78,8 +80,11 @@ class FreeSpace:
         """The free space of ``sim``, whose world is this one's with more static bodies (an episode's
         obstacles): only the cells near the new bodies are looked at again, with the same distances and
         comparison as the whole-world transform, so the answer is the one a new :class:`FreeSpace` gives.
-        A world that differs otherwise (another grid, a body gone) gets a new FreeSpace."""
+        A world that differs otherwise (another grid, a body gone) gets a new FreeSpace; this very raster (a
+        vector env's worlds of one world file share it) gets this one."""
         static = sim.static
+        if static is self._static:
+            return self
         same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
         if not same_grid:
@@ -105,7 +110,7 @@ class FreeSpace:
             valid = self._cleared_near(self._added_within(blocked, boxes), boxes)
         space = copy.copy(self)
         space.__dict__.pop("_rank", None)  # this space's, not the copy's
-        space._bodies = list(static.bodies)
+        space._static, space._bodies = static, list(static.bodies)
         space._blocked = blocked
         space._compiled = sim.kernels == "numba"
         space._index_near(self, valid, boxes, self._pad + 1, sim.kernels == "numba", lost)

@@ -84,8 +84,9 @@ class Scenario:
 
     @cached_property
     def simulation(self) -> Simulation:
-        """The base world's simulation, from which every episode's world is made when :attr:`changes_world`:
-        shared by the tasks of this scenario, and never stepped."""
+        """The base world's simulation, shared by the tasks of this scenario and never stepped: every episode's
+        world is made from it when :attr:`changes_world`, else each task's simulation of the base world (which
+        shares its static parts)."""
         return Simulation(self.base)
 
     @property

@@ -194,8 +194,9 @@ class NavigationTask:
         self.scenario = scenario
         self.config = config
         # The base of worlds made per episode is shared with the scenario's other tasks; a fixed world is stepped,
-        # each task its own.
-        self._base = scenario.simulation if scenario.changes_world else Simulation(scenario.base)
+        # each task its own, made from that base (all that is static shared).
+        base = scenario.simulation
+        self._base = base if scenario.changes_world else base.with_static_models(scenario.base)
         self.sim = self._base
         self.agents = list(range(len(self._base.robots))) if agents is None else list(agents)
         self._agent_rows = np.asarray(self.agents, dtype=np.int64)

@@ -109,7 +109,11 @@ class RangerSensing:
         self._robots = robots
         self._ray_height = np.concatenate(heights) if heights else np.zeros(0)
         self._beam_tables = self._tables_by_height(robots)
-        self._groups = self._height_groups(static)
+        self._static = static
+        self._casters: dict[tuple[str, int, int], RayCaster] = {}
+        """The casters of ``_static``'s layers by kernels, threads and layer (its id), shared by every sensing
+        over that raster (:meth:`over`)."""
+        self._groups = self._height_groups()
         self._slices = self._ranger_slices()
         self._scan_slots = [(robot_index, ranger.index, part)
                             for (robot_index, ranger), part in zip(self._rangers, self._slices, strict=True)]
@@ -123,12 +127,15 @@ class RangerSensing:
 
     def over(self, static: StaticRaster, grid: GridFrame, backend: Backend,
              raster: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]) -> RangerSensing:
-        """These rangers over another static world (an episode's obstacles added: an env's reset), on ``backend``:
-        what a new RangerSensing of the same robots gives, the beam tables shared (they depend on the robots
-        alone), the casters made for ``static`` and everything a cast changes fresh."""
+        """These rangers over a static world (an episode's obstacles added: an env's reset; or this very one: a
+        vector env's worlds of one world file), on ``backend``: what a new RangerSensing of the same robots gives,
+        the beam tables shared (they depend on the robots alone), the casters too when ``static`` is this sensing's
+        own raster (a caster holds nothing a cast changes: each world keeps its own robot layer), else made for
+        ``static``, and everything a cast changes fresh."""
         sensing = copy.copy(self)
         sensing._grid, sensing._backend, sensing._raster = grid, backend, raster
-        sensing._groups = sensing._height_groups(static)
+        sensing._static, sensing._casters = static, self._casters if static is self._static else {}
+        sensing._groups = sensing._height_groups()
         sensing._start()
         return sensing
 
@@ -383,17 +390,18 @@ class RangerSensing:
                 returns))
         return tables
 
-    def _height_groups(self, static: StaticRaster) -> list[HeightGroup]:
-        """The beam tables over ``static``: each height's static layer and its caster (heights that see the same
-        static cells share one)."""
+    def _height_groups(self) -> list[HeightGroup]:
+        """The beam tables over the static world: each height's static layer and its caster (heights that see the
+        same static cells share one), each with a robot layer of its own."""
         groups = []
-        casters: dict[int, RayCaster] = {}
+        static, casters = self._static, self._casters
         for table in self._beam_tables:
             occupied, intensity = static.sensing_tiles(table.height)
-            if id(occupied) not in casters:
-                casters[id(occupied)] = self._backend.caster(occupied, static.resolution, static.origin_xy,
-                                                             threads=self._grid.threads)
-            caster = casters[id(occupied)]
+            key = (self._backend.name, self._grid.threads, id(occupied))
+            caster = casters.get(key)
+            if caster is None:  # kept once made: worlds switching kernels on background threads agree on one
+                caster = casters.setdefault(key, self._backend.caster(occupied, static.resolution, static.origin_xy,
+                                                                      threads=self._grid.threads))
             groups.append(HeightGroup(
                 rays=table.rays, owner=table.owner, ranger=table.ranger, angle=table.angle,
                 max_range=table.max_range, caster=caster, robots=caster.robot_layer(), intensity=intensity,

@@ -95,13 +95,15 @@ class Simulation:
         Built from this simulation's robots and raster, only the new bodies traced (the grid grown when they
         reach past it), when ``description`` keeps this world's top-level models (the very objects, in order),
         adds no robot and puts the new static models after this world's (an environment's reset builds one
-        world per episode); else built from scratch."""
+        world per episode); else built from scratch. With no model added it is this very world, and shares all
+        that is static with this simulation: the raster, its tiles and the rays' casters (a vector env's worlds
+        of one world file hold them once)."""
         added = self._added_static(description)
         if added is None:
             return Simulation(description, seed, self.watchdog_timeout, self._kernels_asked, self.threads)
         # Traced on the kernels the new simulation starts on: not this one's, which a base world that is never
         # stepped (an env's) keeps on numpy for good, its upgrade never adopted.
-        static = with_models(self.static, added, backend_for(self.starting_kernels()).trace)
+        static = with_models(self.static, added, backend_for(self.starting_kernels()).trace) if added else self.static
         sim = copy.copy(self)  # shares what never changes (robots, bodies, drives); the state is reset below
         sim._furnish(description, static, self._sensing)
         sim.reset(seed)
@@ -396,7 +398,10 @@ class Simulation:
 
     def build_parts(self, kernels: str, rangers_of: RangerSensing | None = None) -> tuple[Contact, RangerSensing]:
         """The collision checker and the ranger sensing of this world on ``kernels`` (stateless until used);
-        ``rangers_of``: a sensing of these robots whose beam tables to share."""
+        ``rangers_of``: a sensing of these robots whose beam tables (and casters, over the same raster) to share,
+        by default this simulation's own (a switch of kernels: the worlds of a vector env share them still)."""
+        if rangers_of is None:
+            rangers_of = getattr(self, "_sensing", None)  # none yet while the simulation is first furnished
         backend = backend_for(kernels)
         grid = GridFrame(self.static.shape, self.static.resolution, self.static.origin_xy, self.threads)
         collision = self._make_collision_checker(backend, grid)

@@ -406,6 +406,31 @@ def test_static_models_that_reach_past_the_grid_grow_it_as_a_world_built_from_sc
                for a, b in zip(built.scans, fresh.scans, strict=True))
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
+def test_simulations_of_the_same_world_share_its_static_parts_and_step_apart(kernels: str) -> None:
+    # A vector env's worlds of one world file: each is its own simulation (poses, scans, robot layer), and the
+    # raster, its tiles and the rays' casters are held once; each steps as a simulation built from scratch.
+    robots = 'bot( pose [2 5 0 0] ) bot( pose [6 6 0 90] )'
+    base = Simulation(world(robots), seed=1, kernels=kernels)
+    twins = [base.with_static_models(base.description, seed=seed) for seed in (4, 5)]
+    fresh = [Simulation(base.description, seed=seed, kernels=kernels) for seed in (4, 5)]
+    casters = [{id(group.caster) for group in sim._sensing._groups} for sim in (base, *twins)]
+    assert all(sim.static is base.static for sim in twins) and casters[1] == casters[2] == casters[0]
+    assert twins[0]._sensing._groups[0].robots is not twins[1]._sensing._groups[0].robots
+    for k in range(30):
+        for sims, turn in ((twins, 0.3), (fresh, 0.3)):
+            sims[0].set_velocity(0, 0.6, 0.0, turn * math.sin(k / 4))
+            sims[1].set_velocity(1, 0.5, 0.0, -0.2)
+            for sim in sims:
+                sim.step()
+    for twin, alone in zip(twins, fresh, strict=True):
+        assert np.array_equal(twin.true_poses, alone.true_poses) and np.array_equal(twin.stalled, alone.stalled)
+        assert np.array_equal(twin.odometry_poses, alone.odometry_poses)
+        assert all(np.array_equal(a[0].ranges, b[0].ranges) and np.array_equal(a[0].intensities, b[0].intensities)
+                   for a, b in zip(twin.scans, alone.scans, strict=True))
+    assert not np.array_equal(twins[0].true_poses, twins[1].true_poses)
+
+
 def test_a_world_that_is_not_this_one_plus_static_models_is_built_from_scratch() -> None:
     sim = sim_of('bot( pose [2 5 0 0] )')
     other = world('bot( pose [3 5 0 0] )')
