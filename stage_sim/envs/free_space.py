@@ -54,7 +54,11 @@ class FreeSpace:
         self._robots = robots
         self._margin = margin
         self._bodies = list(static.bodies)
-        self._blocked = self._blocked_of(sim)
+        self._blocked: np.ndarray | None = self._blocked_of(sim)
+        """The cells no part of a robot may cover (:attr:`blocked_cells`); None in a space derived from another
+        (:meth:`with_world`), which holds what it adds instead: ``_blocked_from``."""
+        self._blocked_from: tuple[FreeSpace, list[StaticBody]] | None = None
+        self.shape = static.shape
         self.radius = max(sim.robots[i].radius for i in robots)
         self._reach = self.radius + margin + static.resolution
         """A valid centre is farther than this (m) from every blocking cell."""
@@ -85,23 +89,23 @@ class FreeSpace:
         static = sim.static
         if static is self._static:
             return self
-        same_grid = (static.shape == self._blocked.shape and static.resolution == self.resolution
+        same_grid = (static.shape == self.shape and static.resolution == self.resolution
                      and np.array_equal(np.asarray(static.origin_xy, dtype=np.float64), self.origin))
         if not same_grid:
             return FreeSpace(sim, self._robots, self._margin)
         bodies = self._added_bodies(sim)
         lost = None
         if bodies is None:  # not this world's bodies and more: only a grid that lost no blocked cell is redone here
-            blocked = self._blocked_of(sim)
-            if (self._blocked & ~blocked).any():
+            blocked, mine = self._blocked_of(sim), self.blocked_cells
+            if (mine & ~blocked).any():
                 return FreeSpace(sim, self._robots, self._margin)
-            added = blocked & ~self._blocked
+            added = blocked & ~mine
             boxes = _clusters(added, np.flatnonzero(added))
             valid = self._cleared_near(added, boxes)
         elif sim.kernels == "numba":
             from stage_sim.envs.free_space_kernels import add_bodies
 
-            blocked, valid = self._blocked.copy(), self._valid.copy()
+            blocked, valid = self.blocked_cells.copy(), self.valid_centres.copy()
             lost, found = (add_bodies(blocked, valid, bodies, self._spans) if bodies
                            else (np.zeros(0, dtype=np.int64), np.zeros((0, 4), dtype=np.int64)))
             boxes = [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in found.tolist()]
@@ -111,7 +115,10 @@ class FreeSpace:
         space = copy.copy(self)
         space.__dict__.pop("_rank", None)  # this space's, not the copy's
         space._static, space._bodies = static, list(static.bodies)
-        space._blocked = blocked
+        if bodies is None:
+            space._blocked = blocked
+        else:  # this space and the bodies, not a grid: an episode's space holds no copy of the whole world
+            space._blocked, space._blocked_from = None, (self, bodies)
         space._compiled = sim.kernels == "numba"
         space._index_near(self, valid, boxes, self._pad + 1, sim.kernels == "numba", lost)
         return space
@@ -120,7 +127,7 @@ class FreeSpace:
         """This space's valid centres less those within reach of the ``added`` blocked cells, all within
         ``boxes``: a distance transform around each box (the numpy reference of
         :func:`~stage_sim.envs.free_space_kernels.add_bodies`)."""
-        valid = self._valid.copy()
+        valid = self.valid_centres.copy()
         pad = self._pad
         for rows, cols in boxes:
             window = (slice(max(rows.start - pad, 0), rows.stop + pad),
@@ -148,7 +155,7 @@ class FreeSpace:
         """Per flat grid cell, the position of a valid centre among :attr:`cells` (int32; what the others hold
         means nothing): where the cells an episode's obstacles take lie among this space's, without a search
         through some 340,000 of them."""
-        return np.cumsum(self._valid.ravel(), dtype=np.int32) - 1
+        return np.cumsum(self.valid_centres.ravel(), dtype=np.int32) - 1
 
     def _blocked_of(self, sim: Simulation) -> np.ndarray:
         """Cells no part of a robot may cover: the filled bodies of every height band of the robots."""
@@ -171,7 +178,7 @@ class FreeSpace:
     def _blocked_with(self, bodies: list[StaticBody]) -> tuple[np.ndarray, list[tuple[slice, slice]]]:
         """This space's blocked cells and the filled footprints of ``bodies`` (on its grid), with a box (rows, cols)
         holding each footprint."""
-        blocked = self._blocked.copy()
+        blocked = self.blocked_cells.copy()
         boxes = []
         for body in bodies:
             blocked.ravel()[body.cells] = True
@@ -184,16 +191,16 @@ class FreeSpace:
 
     def _added_within(self, blocked: np.ndarray, boxes: list[tuple[slice, slice]]) -> np.ndarray:
         """The cells ``blocked`` holds and this space's blocked cells do not, all within ``boxes`` (what
-        ``blocked & ~self._blocked`` gives, without a pass over the whole grid)."""
-        added = np.zeros_like(blocked)
+        ``blocked & ~self.blocked_cells`` gives, without a pass over the whole grid)."""
+        added, mine = np.zeros_like(blocked), self.blocked_cells
         for rows, cols in boxes:
-            added[rows, cols] = blocked[rows, cols] & ~self._blocked[rows, cols]
+            added[rows, cols] = blocked[rows, cols] & ~mine[rows, cols]
         return added
 
     def _index(self, valid: np.ndarray, compiled: bool) -> None:
         """Regions and cells of the valid centres ``valid`` (a grid of bools); ``compiled``: label them with the
         compiled twin of scipy's labelling (:mod:`stage_sim.envs.free_space_kernels`, the same labels)."""
-        self._valid = valid
+        self._valid: np.ndarray | None = valid
         regions, self._count = _label(valid, compiled)
         self._regions: np.ndarray | None = regions
         cells = np.flatnonzero(valid)
@@ -216,7 +223,8 @@ class FreeSpace:
         are one region within it, so is ``valid`` (a path between two centres that crossed a lost cell enters
         its window at a centre and leaves it at one of its outer cells, never lost; the two are joined inside
         the window), and its cells are ``base``'s less those lost, looked up in ``base``'s without a copy
-        (:class:`_CellIndex`). A window split in two may join around its obstacle a little farther out: the
+        (:class:`_CellIndex`), as are its valid centres (``valid`` is not kept: an episode's space holds no grid of
+        the whole world). A window split in two may join around its obstacle a little farther out: the
         windows are tried :data:`WINDOW_TRIES` times, wider each time, while they cover at most
         :data:`WINDOWS_SHARE` of the grid; then the whole grid is labelled. ``lost``: the flat cells ``base`` holds
         and ``valid`` does not, sorted, when known (else found in the windows)."""
@@ -233,13 +241,15 @@ class FreeSpace:
         if windows is None:
             self._index(valid, compiled)
             return
+        base_valid = base.valid_centres
         if lost is None:
-            local = [np.flatnonzero(base._valid[window] & ~valid[window]) for window in windows]
+            local = [np.flatnonzero(base_valid[window] & ~valid[window]) for window in windows]
             flat = [(rows.start + cells // (cols.stop - cols.start)) * self.width + cols.start
                     + cells % (cols.stop - cols.start) for (rows, cols), cells in zip(windows, local, strict=True)]
             lost = np.sort(np.concatenate([np.zeros(0, dtype=np.int64), *flat]))
         positions = base._rank[lost].astype(np.int64)
-        self._valid = valid
+        self._valid = None  # the base's valid centres less ``lost``: those two, not a grid of its own
+        self._lost_from = (base_valid, lost)
         self._count = 1
         self._regions = None
         self._cells = _CellIndex(base.cells, positions)
@@ -260,8 +270,32 @@ class FreeSpace:
         """(H, W) int32 region label of every cell (0: not a valid centre), numbered as scipy's 8-connected
         labelling numbers them."""
         if self._regions is None:  # one region: its label is 1
-            self._regions = self._valid.astype(np.int32)
+            self._regions = self.valid_centres.astype(np.int32)
         return self._regions
+
+    @property
+    def blocked_cells(self) -> np.ndarray:
+        """(H, W) bool: the cells no part of a robot may cover (a derived space makes the grid on request from
+        its base's and the bodies it adds)."""
+        if self._blocked is None:
+            assert self._blocked_from is not None
+            base, bodies = self._blocked_from
+            blocked = base.blocked_cells.copy()
+            for body in bodies:
+                blocked.ravel()[body.cells] = True
+            return blocked
+        return self._blocked
+
+    @property
+    def valid_centres(self) -> np.ndarray:
+        """(H, W) bool: whether each cell is a valid centre (an episode's space of one region makes the grid on
+        request: it holds only what its base's lost)."""
+        if self._valid is None:
+            base_valid, lost = self._lost_from
+            valid = base_valid.copy()
+            valid.ravel()[lost] = False
+            return valid
+        return self._valid
 
     def centres(self, cells: np.ndarray) -> np.ndarray:
         """World (x, y) of the centres of flat cell indices."""
@@ -275,17 +309,25 @@ class FreeSpace:
     def _axes(self) -> tuple[np.ndarray, np.ndarray]:
         """The x of every column's centres and the y of every row's (``origin + (index + 0.5) · resolution``):
         a draw looks its candidates up rather than working them out."""
-        height = self._blocked.shape[0]
+        height = self.shape[0]
         return (self.origin[0] + (np.arange(self.width) + 0.5) * self.resolution,
                 self.origin[1] + (np.arange(height) + 0.5) * self.resolution)
 
     def region_of(self, points: np.ndarray) -> np.ndarray:
         """Region label at world points (0: not a valid centre)."""
         cols, rows = np.floor((np.asarray(points) - self.origin) / self.resolution).astype(np.int64).T
-        inside = (rows >= 0) & (rows < self._valid.shape[0]) & (cols >= 0) & (cols < self.width)
+        inside = (rows >= 0) & (rows < self.shape[0]) & (cols >= 0) & (cols < self.width)
         labels = np.zeros(len(rows), dtype=np.int32)
-        grid = self._valid if self._regions is None else self._regions  # one region: valid is its label
-        labels[inside] = grid[rows[inside], cols[inside]]
+        if self._regions is not None:
+            labels[inside] = self._regions[rows[inside], cols[inside]]
+        elif self._valid is not None:  # one region: valid is its label
+            labels[inside] = self._valid[rows[inside], cols[inside]]
+        else:  # one region, the base's valid centres less those lost
+            base_valid, lost = self._lost_from
+            flat = rows[inside] * self.width + cols[inside]
+            at = np.minimum(np.searchsorted(lost, flat), max(lost.size - 1, 0))
+            gone = lost[at] == flat if lost.size else np.zeros(flat.size, dtype=bool)
+            labels[inside] = base_valid.ravel()[flat] & ~gone
         return labels
 
     def draw(

@@ -130,6 +130,11 @@ def test_an_episode_free_space_derives_the_next_one_as_a_fresh_free_space() -> N
     for seed in range(6):
         world = scenario.world(np.random.default_rng(seed), base)
         derived = root.with_world(Simulation(world, kernels="numba"))
+        alone = FreeSpace(Simulation(world, kernels="numba"), [0], 0.1)
+        np.testing.assert_array_equal(derived.valid_centres, alone.valid_centres)
+        np.testing.assert_array_equal(derived.blocked_cells, alone.blocked_cells)
+        points = np.random.default_rng(seed).uniform(-16.0, 16.0, (2_000, 2))  # some off the grid
+        np.testing.assert_array_equal(derived.region_of(points) > 0, alone.region_of(points) > 0)
         boxes = np.array([[-6.0 + 2.5 * seed, 5.0, 0.8, 0.5, 0.3], [4.0, -7.0 + 2.0 * seed, 0.6, 0.9, -1.0]])
         more = scenario.source.add(world, obstacle_models(boxes, world.settings), False)
         sim = Simulation(more, kernels="numba")
