@@ -116,7 +116,7 @@ class FreeSpace:
         space.__dict__.pop("_rank", None)  # this space's, not the copy's
         space._static, space._bodies = static, list(static.bodies)
         if bodies is None:
-            space._blocked = blocked
+            space._blocked, space._blocked_from = blocked, None
         else:  # this space and the bodies, not a grid: an episode's space holds no copy of the whole world
             space._blocked, space._blocked_from = None, (self, bodies)
         space._compiled = sim.kernels == "numba"
