@@ -92,7 +92,8 @@ def _goal_polar(pose, goal):
 def _observe_into(ranges, first_beam, range_max, history, poses, velocities, stalled, agents, goals, tail_low,
                   tail_high, before, active, at_limit, weights, rows, rewards, distance, flags):
     """:func:`observe_and_score` into the given arrays, agent a's newest scan ``ranges[first_beam[a]:][:B]``
-    (``before`` may be ``distance``: each agent's is read before it is written)."""
+    (``before`` may be ``distance``: each agent's is read before it is written), agent a at its step limit when
+    ``at_limit[a]``."""
     count, depth, beams = history.shape
     scans = depth * beams
     progress, arrival, collision, time, tolerance = weights[0], weights[1], weights[2], weights[3], weights[4]
@@ -118,7 +119,7 @@ def _observe_into(ranges, first_beam, range_max, history, poses, velocities, sta
                   - collision * (1.0 if collided else 0.0) - time)
         live = active[a]
         terminated = (arrived or collided) and live
-        truncated = not terminated and live and at_limit
+        truncated = not terminated and live and at_limit[a]
         rewards[a] = reward * (1.0 if live else 0.0)
         flags[0, a], flags[1, a] = terminated, truncated
         flags[2, a], flags[3, a], flags[4, a] = arrived and live, collided and live, live
@@ -131,7 +132,8 @@ def observe_and_score(ranges, range_max, history, poses, velocities, stalled, ag
     """Per agent a: its goal's distance and bearing from its robot's pose, shift the newest scan ``ranges[a]`` /
     ``range_max`` (clipped to [0, 1]) into ``history`` (A, k, B), its observation row (the history, then
     distance, bearing, forward speed and turn rate clipped to the tail bounds), its reward and (terminated,
-    truncated, arrived, collided, was active) flags; agents whose episode ends leave ``active``. Returns the
+    truncated, arrived, collided, was active) flags, truncated at its step limit (``at_limit[a]``: a vector env's
+    worlds reach theirs apart); agents whose episode ends leave ``active``. Returns the
     rows (A, D) float32, rewards (A,), distances (A,) and flags (5, A), made here (arrays made in the kernel
     cost less than arrays handed to it). ``weights``: progress, arrival, collision, time, goal tolerance."""
     count, depth, beams = history.shape

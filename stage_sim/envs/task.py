@@ -164,8 +164,27 @@ def compiled_finish_step(
     """:func:`finish_step` in one compiled pass: goal distance and bearing, observe, score and end episodes."""
     rows, rewards, distance, flags = _kernels().observe_and_score(
         first_laser_ranges(sim, agents), observer.range_scale, observer.history, sim.true_poses, sim.velocities,
-        sim.stalled, agents, goals, observer.tail_low, observer.tail_high, before, active, at_limit, reward.weights)
+        sim.stalled, agents, goals, observer.tail_low, observer.tail_high, before, active,
+        np.full(len(agents), at_limit), reward.weights)
     return StepResult(rows, rewards, flags[0], flags[1], flags[2], flags[3], distance, flags[4])
+
+
+def compiled_finish_rows(
+    observer: ObservationBuilder, reward: RewardConfig, ranges: np.ndarray, poses: np.ndarray,
+    velocities: np.ndarray, stalled: np.ndarray, goals: np.ndarray, before: np.ndarray, active: np.ndarray,
+    at_limit: np.ndarray,
+) -> StepResult:
+    """:func:`compiled_finish_step` of agents given as rows, agent a's newest ranges ``ranges[a]`` (A, B), pose,
+    velocity and stall flag ``poses[a]``, ``velocities[a]``, ``stalled[a]``, at its step limit when
+    ``at_limit[a]``: a vector env's worlds, one agent each, whose state the batch stepping them holds stacked (one
+    compiled pass for all of them instead of a dozen numpy calls). Agents whose episode ends leave ``active``."""
+    rows = np.arange(len(poses))
+    contiguous = np.ascontiguousarray  # the arrays the warmed-up kernel takes, whatever robot a world's agent is
+    observations, rewards, distance, flags = _kernels().observe_and_score(
+        contiguous(ranges), observer.range_scale, observer.history, contiguous(poses), contiguous(velocities),
+        contiguous(stalled), rows, goals, observer.tail_low, observer.tail_high, before, active, at_limit,
+        reward.weights)
+    return StepResult(observations, rewards, flags[0], flags[1], flags[2], flags[3], distance, flags[4])
 
 
 class _CompiledStep:
@@ -179,6 +198,7 @@ class _CompiledStep:
         self.kernel = kernels.discrete_step if actions.discrete else kernels.continuous_step
         self.rewards, self.distance, flags = np.zeros(count), np.zeros(count), np.zeros((5, count), dtype=bool)
         self.flags = tuple(flags)  # terminated, truncated, arrived, collided, was active
+        self.limits = (np.zeros(count, dtype=bool), np.ones(count, dtype=bool))  # every agent at its limit or none
         self.tables = kernels.task_tables(
             task._agent_rows, np.array([task.sim.beams_of(agent).start for agent in task.agents], dtype=np.int64),
             observer.range_scale, observer.history, observer.tail_low, observer.tail_high,
@@ -247,7 +267,7 @@ class NavigationTask:
             whole = self._compiled or self._compile()
             rows = np.empty((len(agents), whole.size), dtype=np.float32)
             if sim.step_with(whole.kernel, (whole.tables, self.actions.arrays(actions), sim.last_command_us,
-                                            sim.sim_time_us, self.goals, at_limit, rows)):
+                                            sim.sim_time_us, self.goals, whole.limits[at_limit], rows)):
                 return StepResult(rows, whole.rewards, *whole.flags[:4], self.distance, whole.flags[4])
         else:
             (compiled_command_agents if compiled else command_agents)(sim, agents, self.actions, actions, self.active)

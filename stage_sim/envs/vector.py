@@ -5,7 +5,8 @@ default mode for this id) builds it. World i is what ``gymnasium.make("stage_sim
 be, seeded with ``seed + i`` (or ``seed[i]``), and the vector env is identical to N such envs in a
 ``SyncVectorEnv`` step for step, but it does the task's work (commands, observations, rewards, episode ends)
 once for all worlds as arrays instead of once per world, and the worlds' simulation steps in one compiled call
-(:class:`~stage_sim.sim.simulation.SimulationBatch`).
+(:class:`~stage_sim.sim.simulation.SimulationBatch`); on the compiled kernels the observations, rewards and episode
+ends of all worlds are one compiled call too (:func:`~stage_sim.envs.task.compiled_finish_rows`).
 
 Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
 next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
@@ -28,7 +29,15 @@ from gymnasium.vector.utils import batch_space
 
 from stage_sim.envs.scenarios import Scenario, ScenarioOptions
 from stage_sim.envs.spaces import ActionMap, ObservationBuilder, first_laser_ranges, goal_polar
-from stage_sim.envs.task import NavigationTask, RewardConfig, StepResult, TaskConfig, score, step_result
+from stage_sim.envs.task import (
+    NavigationTask,
+    RewardConfig,
+    StepResult,
+    TaskConfig,
+    compiled_finish_rows,
+    score,
+    step_result,
+)
 from stage_sim.sim.simulation import SimulationBatch
 
 
@@ -155,21 +164,25 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
             sim.set_velocity(robot, forward, 0.0, turn)
         batch.step(stepping, worlds)
         self.steps += moving
-        if batch.whole:  # the stepped worlds' state as the batch holds it (the other worlds' rows are reset next)
-            poses, velocity, stalled = batch.poses[:, robot], batch.velocities[:, robot], batch.stalled[:, robot]
-            ranges = batch.ranges[:, self._beams]
-        else:
-            sims = [task.sim for task in self.tasks]
-            poses = np.array([sim.true_poses[robot] for sim in sims])
-            ranges = np.concatenate([first_laser_ranges(sim, np.array([robot])) for sim in sims])
-            velocity = np.array([sim.velocities[robot] for sim in sims])
-            stalled = np.array([sim.stalled[robot] for sim in sims])
+        at_limit = self.steps >= self.config.max_steps
+        if batch.whole:  # compiled worlds: scored in one compiled pass from the state the batch holds of them (the
+            # worlds that stood have their rows as they were, and are reset next)
+            result = compiled_finish_rows(
+                self._observer, self.config.reward, batch.ranges[:, self._beams], batch.poses[:, robot],
+                batch.velocities[:, robot], batch.stalled[:, robot], self.goals, self.distance, moving.copy(), at_limit)
+            self.distance = result.distance
+            return result
+        sims = [task.sim for task in self.tasks]
+        poses = np.array([sim.true_poses[robot] for sim in sims])
+        ranges = np.concatenate([first_laser_ranges(sim, np.array([robot])) for sim in sims])
+        velocity = np.array([sim.velocities[robot] for sim in sims])
+        stalled = np.array([sim.stalled[robot] for sim in sims])
         before = self.distance
         distance, bearing = goal_polar(poses, self.goals)
         observations = self._observer.observe_arrays(ranges, velocity, distance, bearing)
         outcome = score(self.config.reward, before, distance, stalled)
         self.distance = distance
-        return step_result(outcome, observations, distance, moving, self.steps >= self.config.max_steps)
+        return step_result(outcome, observations, distance, moving, at_limit)
 
     def _reset_world(self, world: int, seed: int | None) -> np.ndarray:
         """Reset world ``world`` as ``NavigateEnv.reset(seed=seed)`` would and return its first observation."""

@@ -10,14 +10,15 @@ import os
 
 from stage_sim.backend import KERNELS_ENV, numba_available
 from stage_sim.envs.navigate import NavigateEnv
+from stage_sim.envs.vector import NavigateVectorEnv
 from stage_sim.envs.worlds import RobotBody
 from stage_sim.sim import warm_up
 
 
 def warm() -> None:
     """Run every kernel once (compiling what the cache lacks): the simulation's, then an obstacles episode of a
-    small env with continuous and with discrete actions, stepped (in one call, and part by part) and reset on the
-    compiled kernels."""
+    small env with continuous and with discrete actions, stepped (in one call, and part by part) and reset, and a
+    small vector env's steps, on the compiled kernels."""
     warm_up.warm()
     if not numba_available():
         return
@@ -34,6 +35,12 @@ def warm() -> None:
             env.task.sim.watchdog_timeout = 60.0
             env.step(env.action_space.sample())
             env.reset()  # an episode's free space, derived from the first one's
+        # a vector env's worlds, stepped and scored together (the kernels take the batch's arrays)
+        worlds = NavigateVectorEnv(2, scenario="obstacles", arena_size=6.0, n_obstacles=2,
+                                   body=RobotBody(laser_samples=16))
+        worlds.reset(seed=0)
+        for _ in range(2):
+            worlds.step(worlds.action_space.sample())
     finally:
         if asked is None:
             del os.environ[KERNELS_ENV]

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import stage_sim.envs  # noqa: F401  (registers stage_sim/Navigate-v0)
+from stage_sim.backend import KERNELS_ENV
 from stage_sim.envs import ENV_ID, NavigateVectorEnv, RobotBody
 
 SMALL = RobotBody(laser_samples=32)
@@ -30,10 +31,13 @@ def test_make_vec_builds_the_batched_vector_env_with_batched_spaces():
     assert envs.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
 
 
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
 @pytest.mark.parametrize(("discrete", "scenario"), [(False, "obstacles"), (True, "obstacles"), (False, "random")])
-def test_identical_step_for_step_to_n_separate_envs_with_the_same_seeds(discrete, scenario):
+def test_identical_step_for_step_to_n_separate_envs_with_the_same_seeds(discrete, scenario, kernels, monkeypatch):
     # The batched worlds share their base world and its free space (a world of its own per episode, or a fixed
-    # world that each steps on its own): the separate envs each work theirs out.
+    # world that each steps on its own): the separate envs each work theirs out. On numba the worlds step in one
+    # compiled call and are scored in another; on numpy each steps and the scores are numpy's.
+    monkeypatch.setenv(KERNELS_ENV, kernels)
     count = 4
     batched = make_vector(count, discrete=discrete, scenario=scenario)
     separate = gymnasium.vector.SyncVectorEnv(
@@ -51,6 +55,7 @@ def test_identical_step_for_step_to_n_separate_envs_with_the_same_seeds(discrete
             assert mine.dtype == theirs.dtype
             assert np.array_equal(mine, theirs)
         ended += int(np.sum(got[2] | got[3]))
+        assert batched.unwrapped._batch.whole == (kernels == "numba")
     assert ended >= count  # the comparison went through autoresets, not just one episode per world
     # a reset with a list of seeds, then more steps: still the same
     assert np.array_equal(batched.reset(seed=[3, 1, 4, 1])[0], separate.reset(seed=[3, 1, 4, 1])[0])
@@ -100,9 +105,11 @@ def assert_same_infos(mine: dict, theirs: dict) -> None:
             assert np.array_equal(mine[key][mask], value[mask]), key
 
 
-def test_same_step_autoreset_is_sync_vector_envs_step_for_step_infos_included():
+@pytest.mark.parametrize("kernels", ["numpy", "numba"])
+def test_same_step_autoreset_is_sync_vector_envs_step_for_step_infos_included(kernels, monkeypatch):
     """What Stable-Baselines3 and older libraries expect: the step that ends an episode returns the next
     one's first observation, the last in infos["final_obs"]."""
+    monkeypatch.setenv(KERNELS_ENV, kernels)
     count, same_step = 3, gymnasium.vector.AutoresetMode.SAME_STEP
     batched = make_vector(count, autoreset_mode="SameStep")
     assert batched.metadata["autoreset_mode"] == same_step
@@ -118,6 +125,7 @@ def test_same_step_autoreset_is_sync_vector_envs_step_for_step_infos_included():
             assert mine.dtype == theirs.dtype and np.array_equal(mine, theirs)
         assert_same_infos(got[4], want[4])
         ended += int(np.sum(got[2] | got[3]))
+        assert batched.unwrapped._batch.whole == (kernels == "numba")
     assert ended >= count
 
 
