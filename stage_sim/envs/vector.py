@@ -165,8 +165,9 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         batch.step(stepping, worlds)
         self.steps += moving
         at_limit = self.steps >= self.config.max_steps
-        if batch.whole:  # compiled worlds: scored in one compiled pass from the state the batch holds of them (the
-            # worlds that stood have their rows as they were, and are reset next)
+        # Compiled worlds, all stepped in the batch's call: scored in one compiled pass from the state it holds of
+        # them (the worlds that stood keep their rows as they were, and are reset next).
+        if batch.whole:
             result = compiled_finish_rows(
                 self._observer, self.config.reward, batch.ranges[:, self._beams], batch.poses[:, robot],
                 batch.velocities[:, robot], batch.stalled[:, robot], self.goals, self.distance, moving.copy(), at_limit)
