@@ -25,6 +25,9 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
   (:class:`~stage_sim.sim.simulation.SimulationBatch`), whose time per world is ``kernel_us``, and
   ``step_glue_us`` is the batch's Python per world. The envs are timed in turns, ``--seconds`` each in
   :data:`SLICES` slices, so that a slow phase of the machine weighs on both rows alike.
+* ``memory``: what one world more holds in a vector env (the obstacles scenario and the fixed ``random`` one;
+  the full robot body, 512 beams): Python's traced bytes after a reset and 5 steps of 9 worlds, less those of 3
+  worlds, over 6, on the compiled kernels (the base world's own share is held once, outside the difference).
 * ``baseline``: the scripted ``GoalSeeker`` on circle crossing with 4, 10 and 20 robots (the parallel env)
   and on one robot among 8 random boxes (the Gymnasium env): success rate, collision rate and mean time to
   goal in sim seconds, over ``--episodes`` seeds.
@@ -33,9 +36,12 @@ Run pinned to one core: ``taskset -c 0 .venv/bin/python benchmarks/envs.py [--se
 from __future__ import annotations
 
 import argparse
+import gc
 import json
+import os
 import sys
 import time
+import tracemalloc
 from collections.abc import Callable
 from pathlib import Path
 
@@ -255,6 +261,36 @@ def time_core(sim: Simulation) -> list[float]:
     return spent
 
 
+def world_memory(scenario: str) -> dict:
+    """Traced bytes one world more adds to a vector env of the ``scenario`` (see the module's docstring)."""
+    def held(count: int) -> int:
+        gc.collect()
+        tracemalloc.start()
+        try:
+            envs = NavigateVectorEnv(count, scenario=scenario, n_obstacles=8, **ARENA)
+            envs.reset(seed=0)
+            for _ in range(5):
+                envs.step(np.repeat(ARC[None], count, axis=0))
+            gc.collect()
+            return tracemalloc.get_traced_memory()[0]
+        finally:
+            tracemalloc.stop()
+
+    asked = os.environ.get("STAGE_SIM_KERNELS")
+    os.environ["STAGE_SIM_KERNELS"] = "numba"  # from the first step: numpy's tables are others
+    try:
+        held(1)  # the kernels loaded, outside the count
+        few, many = 3, 9
+        per_world = (held(many) - held(few)) / (many - few)
+    finally:
+        if asked is None:
+            del os.environ["STAGE_SIM_KERNELS"]
+        else:
+            os.environ["STAGE_SIM_KERNELS"] = asked
+    return {"bench": "memory", "env": "NavigateVectorEnv", "scenario": scenario, "worlds": [few, many],
+            "kb_per_world": round(per_world / 1e3, 1)}
+
+
 def baseline(episodes: int) -> list[dict]:
     """The goal seeker's scores through both environments."""
     rows = []
@@ -281,6 +317,8 @@ def main() -> None:
         print(json.dumps(row), flush=True)
     for robots in (10, 100):
         print(json.dumps(parallel_speed(robots, args.seconds)), flush=True)
+    for scenario in ("obstacles", "random"):
+        print(json.dumps(world_memory(scenario)), flush=True)
     for row in baseline(args.episodes) if args.episodes > 0 else []:
         print(json.dumps({k: round(v, 3) if isinstance(v, float) else v for k, v in row.items()}), flush=True)
 
