@@ -138,8 +138,8 @@ class Breakdown:
         self.worlds = worlds
         self.env = NavigateVectorEnv(worlds, **scenario) if worlds else NavigateEnv(**scenario)
         self.env.reset(seed=0)
-        for task in self.env.tasks if worlds else [self.env.task]:
-            task.sim.wait_for_kernels()
+        for sim in [self.env.simulation(k) for k in range(worlds)] if worlds else [self.env.task.sim]:
+            sim.wait_for_kernels()
         rng = np.random.default_rng(1)
         self.count = count = max(worlds, 1)
         self.actions = np.stack([rng.uniform(0.0, 1.0, (1000, count)),

@@ -58,7 +58,7 @@ class NavigateParallelVectorEnv(ParallelEnv):
             batch[self._index[name]] = action
         result = self.worlds.advance(batch, self._live.copy())
         live = [(name, self._index[name]) for name in self.agents]
-        times = self.worlds.steps * self.worlds.tasks[0].sim.interval
+        times = self.worlds.steps * self.worlds.interval
         observations = {name: result.observations[i] for name, i in live}
         rewards = {name: float(result.rewards[i]) for name, i in live}
         terminated = {name: bool(result.terminated[i]) for name, i in live}

@@ -5,8 +5,9 @@ default mode for this id) builds it. World i is what ``gymnasium.make("stage_sim
 be, seeded with ``seed + i`` (or ``seed[i]``), and the vector env is identical to N such envs in a
 ``SyncVectorEnv`` step for step, but it does the task's work (commands, observations, rewards, episode ends)
 once for all worlds as arrays instead of once per world, and the worlds' simulation steps in one compiled call
-(:class:`~stage_sim.sim.simulation.SimulationBatch`); on the compiled kernels the observations, rewards and episode
-ends of all worlds are one compiled call too (:func:`~stage_sim.envs.task.compiled_finish_rows`).
+(:class:`~stage_sim.sim.simulation.SimulationBatch`, which holds the worlds' state between steps: read a
+world's simulation through :meth:`NavigateVectorEnv.simulation`); on the compiled kernels the observations,
+rewards and episode ends of all worlds are one compiled call too (:func:`~stage_sim.envs.task.compiled_finish_rows`).
 
 Autoreset is Gymnasium 1.x's default, next-step: a world whose episode ended in one step is reset by the
 next ``step`` (its action ignored), which returns the new episode's first observation with reward 0 and
@@ -38,7 +39,7 @@ from stage_sim.envs.task import (
     score,
     step_result,
 )
-from stage_sim.sim.simulation import SimulationBatch
+from stage_sim.sim.simulation import Simulation, SimulationBatch
 
 
 class NavigateVectorEnv(gymnasium.vector.VectorEnv):
@@ -62,8 +63,10 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
             raise ValueError("circle crossing needs several robots: use stage_sim.envs.NavigateParallelEnv")
         self.config = TaskConfig(history, max_steps, discrete, reward or RewardConfig())
         scenario = Scenario(options)  # the base world, its simulation and free space: one for all worlds
-        self.tasks = [NavigationTask(scenario, self.config, agents=[robot]) for _ in range(num_envs)]
-        first = self.tasks[0]
+        self._tasks = [NavigationTask(scenario, self.config, agents=[robot]) for _ in range(num_envs)]
+        self._sims = [task.sim for task in self._tasks]  # each world's simulation: held by the batch between steps
+        self._every_world = list(range(num_envs))
+        first = self._tasks[0]
         self.num_envs = num_envs
         self.robot = robot
         self.layout = first.layout
@@ -79,7 +82,7 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         self.distance = np.zeros(num_envs)
         self.steps = np.zeros(num_envs, dtype=np.int64)
         self._autoreset = np.zeros(num_envs, dtype=bool)
-        self._interval = first.sim.interval
+        self.interval = first.sim.interval  #: sim seconds a step
         self._batch = SimulationBatch(num_envs)  # the worlds' steps in one compiled call
         self._beams = first.sim.beams_of(robot)  # the robot's first ranger among the beams
 
@@ -115,7 +118,7 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
             observations[world] = self._reset_world(world, None)
         self._autoreset = result.terminated | result.truncated
         infos = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
-                 "time": self.steps * self._interval}
+                 "time": self.steps * self.interval}
         infos.update({f"_{key}": moving.copy() for key in list(infos)})
         if restart.any():
             infos["goal"], infos["_goal"] = self.goals.copy(), restart
@@ -132,7 +135,7 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         ended = result.terminated | result.truncated
         going = ~ended
         stepped = {"arrived": result.arrived, "collided": result.collided, "distance": self.distance.copy(),
-                   "time": self.steps * self._interval}
+                   "time": self.steps * self.interval}
         infos: dict[str, Any] = {}
         if going.any():  # a key only when some world has it, as SyncVectorEnv gathers them
             for key, values in stepped.items():
@@ -155,14 +158,15 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
     def advance(self, actions: np.ndarray, moving: np.ndarray) -> StepResult:
         """Step the worlds in ``moving`` (the others stand) and score them as arrays: (W,) results, nothing
         for the worlds that stood. No reset: whoever calls it decides what an ended episode leads to."""
-        commands = self.actions.commands(actions).tolist()  # Python floats: a robot's row set without an index array
-        worlds = np.flatnonzero(moving).tolist()
-        stepping = [self.tasks[world].sim for world in worlds]
+        chosen = self.actions.commands(actions)
         robot, batch = self.robot, self._batch
-        for world, sim in zip(worlds, stepping, strict=True):
-            forward, turn = commands[world]
-            sim.set_velocity(robot, forward, 0.0, turn)
-        batch.step(stepping, worlds)
+        commands = np.zeros((self.num_envs, 3))  # (forward, sideways, turn) of each world's robot
+        commands[:, 0], commands[:, 2] = chosen[:, 0], chosen[:, 1]
+        if moving.all():
+            batch.step(self._sims, self._every_world, commands, robot)
+        else:
+            worlds = np.flatnonzero(moving)
+            batch.step([self._sims[world] for world in worlds.tolist()], worlds.tolist(), commands[worlds], robot)
         self.steps += moving
         at_limit = self.steps >= self.config.max_steps
         # Compiled worlds, all stepped in the batch's call: scored in one compiled pass from the state it holds of
@@ -173,7 +177,8 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
                 batch.velocities[:, robot], batch.stalled[:, robot], self.goals, self.distance, moving.copy(), at_limit)
             self.distance = result.distance
             return result
-        sims = [task.sim for task in self.tasks]
+        batch.sync()  # the worlds that did join are read from their simulations too
+        sims = self._sims
         poses = np.array([sim.true_poses[robot] for sim in sims])
         ranges = np.concatenate([first_laser_ranges(sim, np.array([robot])) for sim in sims])
         velocity = np.array([sim.velocities[robot] for sim in sims])
@@ -185,12 +190,20 @@ class NavigateVectorEnv(gymnasium.vector.VectorEnv):
         self.distance = distance
         return step_result(outcome, observations, distance, moving, at_limit)
 
+    def simulation(self, world: int) -> Simulation:
+        """World ``world``'s simulation, up to date (the batch holds the worlds' state between steps). It may be
+        read, and changed between steps as a user of :class:`~stage_sim.sim.simulation.Simulation` would."""
+        self._batch.sync([world])
+        return self._sims[world]
+
     def _reset_world(self, world: int, seed: int | None) -> np.ndarray:
         """Reset world ``world`` as ``NavigateEnv.reset(seed=seed)`` would and return its first observation."""
         if seed is not None or self._rngs[world] is None:
             self._rngs[world], _ = seeding.np_random(seed)
-        task = self.tasks[world]
+        task = self._tasks[world]
+        self._batch.sync([world])  # its simulation as its steps left it, before the reset changes it
         observation = task.reset(self._rngs[world])[0]
+        self._sims[world] = task.sim
         self.goals[world] = task.goals[0]
         self.distance[world] = task.distance[0]
         self.steps[world] = 0

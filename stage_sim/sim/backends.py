@@ -126,14 +126,20 @@ def no_fused_step(collision: Contact, cast: SingleCast | None, threads: int, dri
 class FusedBatch(Protocol):
     """Fused steps of several worlds in one call (:class:`~stage_sim.sim.compiled.FusedBatch`)."""
 
+    beams: int  #: rays every world's step casts
+
     def fits(self, fused: Fused) -> bool:
         """Whether ``fused`` can join the others' call."""
         ...
 
-    def step(self, slots: np.ndarray, steps: list[Fused], poses: np.ndarray, layers: np.ndarray, parity: np.ndarray,
+    def hold(self, slot: int, fused: Fused) -> None:
+        """Step ``fused`` (which fits) in ``slot`` from now on."""
+        ...
+
+    def step(self, slots: np.ndarray, poses: np.ndarray, layers: np.ndarray, parity: np.ndarray,
              estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float, uses_odom: np.ndarray,
              stalled: np.ndarray) -> FusedResult:
-        """Each world's step (every ray cast) on its slot's row of the stacked state: new arrays alike."""
+        """The step held in each slot (every ray cast) on the slot's row of the stacked state: new arrays alike."""
         ...
 
 

@@ -273,36 +273,47 @@ class FusedStep:
 class FusedBatch:
     """The fused steps of several worlds of one shape (the worlds of a vector env) in one compiled call
     (:func:`~stage_sim.sim.fused_kernels.whole_steps`, or its parallel twin on more than one thread), every ray
-    cast: one dispatch and one check of the arguments for all of them. The worlds stay in a typed list between
-    calls, a slot per world, and a slot is written again only when its world's :class:`FusedWorld` changes (a
-    new episode's world, a grown robot layer)."""
+    cast: one dispatch and one check of the arguments for all of them. Each world's step is held in its slot
+    (:meth:`hold`) and its :class:`FusedWorld` stays in a typed list between calls, written again only when the
+    world changes (a new step held in the slot, a grown robot layer)."""
 
     def __init__(self, threads: int) -> None:
         """``threads``: the worlds are shared among that many threads (the same answers)."""
         self._threads = threads
         self._worlds: typed.List | None = None
-        self._held: list[fused_kernels.FusedWorld] = []
+        self._steps: list[FusedStep] = []  # the step held in each slot
         self._type: object = None  # numba's type of the worlds (numba's types are interned: one object per type)
-        self._beams = -1
+        self.beams = -1  #: rays every world's step casts (those of the first asked)
 
     def fits(self, fused: FusedStep) -> bool:
         """Whether ``fused`` can join the others' call: the same rays and the same kinds of arrays as the first
         that was asked."""
         world_type = fused.world()._numba_type_
         if self._type is None:
-            self._type, self._beams = world_type, fused.beams
-        return fused.beams == self._beams and world_type is self._type
+            self._type, self.beams = world_type, fused.beams
+        return fused.beams == self.beams and world_type is self._type
 
-    def step(self, slots: np.ndarray, steps: list[FusedStep], poses: np.ndarray, layers: np.ndarray,
-             parity: np.ndarray, estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float,
-             uses_odom: np.ndarray, stalled: np.ndarray) -> FusedResult:
-        """``steps[k].step`` (every ray cast) of the world in slot ``slots[k]``, on row ``slots[k]`` of the state
-        (a row per slot: ``poses`` (W, N, 3), ``layers`` (W, 2, N, 3) written in place, its layer
-        ``parity[slot]``, ...): new arrays of a row per slot, the stepped slots' rows written (the others' as
-        given; their scans unset); the scans (W, beams). Every step must have passed :meth:`fits`."""
-        worlds = self._hold(slots, steps)
+    def hold(self, slot: int, fused: FusedStep) -> None:
+        """Step ``fused`` (which :meth:`fits`) in ``slot`` from now on."""
+        if self._worlds is None:
+            self._worlds = typed.List.empty_list(self._type)
+        world = fused.world()
+        while len(self._steps) <= slot:
+            self._steps.append(fused)
+            self._worlds.append(world)
+        self._steps[slot] = fused
+        self._worlds[slot] = world
+
+    def step(self, slots: np.ndarray, poses: np.ndarray, layers: np.ndarray, parity: np.ndarray,
+             estimates: np.ndarray, velocities: np.ndarray, errors: np.ndarray, dt: float, uses_odom: np.ndarray,
+             stalled: np.ndarray) -> FusedResult:
+        """The step held in each of ``slots`` (every ray cast), on the slot's row of the state (a row per slot:
+        ``poses`` (W, N, 3), ``layers`` (W, 2, N, 3) written in place, its layer ``parity[slot]``, ...): new arrays
+        of a row per slot, the stepped slots' rows written (the others' as given; their scans unset); the scans
+        (W, beams)."""
+        worlds = self._worlds
         size, n = poses.shape[:2]
-        beams = self._beams
+        beams = self.beams
         integrated, end_trig, final_trig = np.empty((size, n, 3)), np.empty((size, 2, 2 * n)), np.empty((size, 2, n))
         odometry, final, stalled_out = estimates.copy(), poses.copy(), stalled.copy()  # the others' rows: as they were
         published, intensity = np.empty((size, beams), dtype=np.float32), np.empty((size, beams), dtype=np.float32)
@@ -313,24 +324,9 @@ class FusedBatch:
             step_all = fused_kernels.whole_steps_parallel
         step_all(worlds, slots, poses, layers, parity, estimates, velocities, errors, dt, uses_odom, stalled,
                  integrated, end_trig, final_trig, odometry, final, stalled_out, published, intensity, tiles)
-        for k in np.flatnonzero(tiles[slots]):  # a robot layer too small: grown, its rays cast again
-            slot = slots[k]
-            steps[k].cast_grown(int(tiles[slot]), layers[slot], int(parity[slot]), final[slot], final_trig[slot],
-                                published[slot], intensity[slot])
-            self._held[slot] = worlds[slot] = steps[k].world()
+        for slot in np.flatnonzero(tiles).tolist():  # a robot layer too small: grown, its rays cast again
+            fused = self._steps[slot]
+            fused.cast_grown(int(tiles[slot]), layers[slot], int(parity[slot]), final[slot], final_trig[slot],
+                             published[slot], intensity[slot])
+            worlds[slot] = fused.world()
         return FusedResult(final, stalled_out, odometry, layers, (published, intensity), velocities)
-
-    def _hold(self, slots: np.ndarray, steps: list[FusedStep]) -> typed.List:
-        """The typed list with each step's world in its slot."""
-        if self._worlds is None:
-            self._worlds = typed.List.empty_list(self._type)
-        worlds, held = self._worlds, self._held
-        for slot, fused in zip(slots.tolist(), steps, strict=True):
-            world = fused.world()
-            while len(held) <= slot:
-                held.append(world)
-                worlds.append(world)
-            if held[slot] is not world:
-                held[slot] = world
-                worlds[slot] = world
-        return worlds

@@ -259,6 +259,16 @@ class RangerSensing:
         :meth:`invalidate`)."""
         return self._stale or now_us >= self._all_due_us
 
+    def due_every_step(self, now_us: int, interval_us: int) -> bool:
+        """Whether every ranger is due at sim time ``now_us`` and, cast then, at every ``interval_us`` after: none
+        updates more slowly than the step (what a :class:`~stage_sim.sim.simulation.SimulationBatch` holds)."""
+        return self.all_due(now_us) and self._longest_us <= interval_us
+
+    @property
+    def noisy(self) -> bool:
+        """Whether a cast draws noise (:meth:`draw_all_noise` before a fused step's)."""
+        return self._noisy
+
     def none_due(self, now_us: int) -> bool:
         """Whether no ranger is due at sim time ``now_us`` (µs; :meth:`sense` would cast nothing)."""
         return not self._stale and now_us < self._next_due_us

@@ -442,96 +442,124 @@ class _BatchShape:
 
 class SimulationBatch:
     """Simulations stepped together, each as its own :meth:`Simulation.step` would step it (the same poses,
-    flags, odometry and scans, bit for bit), the fused steps of all those that take one (compiled kernels,
-    every ranger due, the same interval and robots) in one compiled call (its worlds shared among the threads
-    of the first that joined, :attr:`Simulation.threads`, the same answers): a vector env's worlds, whose
-    per-world calls and their Python cost more than the step's own work at one robot a world.
+    flags, odometry, scans and clock, bit for bit), the fused steps of all those that take one (compiled kernels,
+    every ranger due at every step, no watchdog, the same interval and robots) in one compiled call (its worlds
+    shared among the threads of the first that joined, :attr:`Simulation.threads`, the same answers): a vector
+    env's worlds, whose per-world calls and Python cost more than the step's own work at one robot a world.
 
-    The worlds' state stays stacked here between steps, a row per slot, and each simulation's arrays are views
-    of its row (new arrays every step, as :meth:`Simulation.step` makes them; its commands stay one array, which
-    :meth:`Simulation.set_velocities` writes in place); a row is copied in again only when its simulation's
-    arrays are not the views it was given (a reset, a pose set, a step of its own). When every simulation of a
-    step joined the call (:attr:`whole`), :attr:`poses`, :attr:`stalled`, :attr:`velocities` and
-    :attr:`ranges` (every beam, float32) are the stepped slots' new state, a row per slot (the other rows as
-    they were before the step, their ranges unset)."""
+    The batch *holds* the simulations that take its call: their state lives here between steps, a row per slot,
+    and a step runs no Python per world. A held simulation is behind until :meth:`sync` brings it up to date (its
+    poses, flags, odometry, velocities, scans and clock as its own steps would have left them; arrays never
+    written afterwards, as :meth:`Simulation.step` makes them): sync it before reading or changing it. Its
+    commands and their times are rows of the batch's (``step``'s ``commands`` write them; after a sync,
+    :meth:`Simulation.set_velocity` does too). A simulation synced and then changed (a reset, a pose set, a step
+    of its own) is taken in again at its next step, from its arrays as they are then; one that cannot take the
+    call steps on its own. When every simulation of a step was held (:attr:`whole`), :attr:`poses`,
+    :attr:`stalled`, :attr:`velocities` and :attr:`ranges` (every beam, float32) are the stepped slots' new
+    state, a row per slot (the other rows as they were before the step, their ranges unset)."""
 
     def __init__(self, size: int) -> None:
         """``size``: the slots, one per world."""
         self.size = size
         self._fused: FusedBatch | None = None  # made when a compiled world first joins
         self._shape: _BatchShape | None = None  # of the first that joined: that of every one that joins
-        self._members: list[tuple[Simulation, object] | None] = [None] * size  # per slot: (simulation, fused step)
-        self._given: list[tuple[object, ...] | None] = [None] * size  # per slot: the arrays its simulation holds
-        self._state: tuple[np.ndarray, ...] = ()  # poses, layers, odometry, stalled, errors, uses_odom, commands
+        self._held: list[Simulation | None] = [None] * size
+        self._given: list[tuple[object, ...] | None] = [None] * size  # per synced slot: what its simulation holds
+        self._unsure: set[int] = set()  # held slots synced since their last step: their simulations may have changed
+        self._noisy: dict[int, RangerSensing] = {}  # held slots whose casts draw noise, by slot
+        self._behind = np.zeros(size, dtype=bool)  # held slots stepped here since their simulation's last sync
+        self._clock = np.zeros(size, dtype=np.int64)  # each slot's sim time (µs) and update count
+        self._updates = np.zeros(size, dtype=np.int64)
+        # poses, layers, odometry, stalled, errors, uses_odom, commands, command times, velocities, ranges, intensities
+        self._state: tuple[np.ndarray, ...] = ()
         self._motion: tuple = ()  # the body velocities' call: motion, drives, wheelbases and bounds of all slots
+        self._last: tuple[list[Simulation], list[int], np.ndarray, list[int]] | None = None  # the last step's sims,
+        # slots, slots as an array and noisy slots, when all of them were held: the next like it needs no sorting
         self.poses = self.stalled = self.velocities = self.ranges = np.empty(0)
         self.whole = False  #: whether every simulation of the last step joined the compiled call
 
-    def step(self, sims: Sequence[Simulation], slots: Sequence[int]) -> None:
+    def step(self, sims: Sequence[Simulation], slots: Sequence[int], commands: np.ndarray | None = None,
+             robot: int = 0) -> None:
         """Step each of ``sims`` once; ``slots[k]``: the slot of ``sims[k]``, the same for a world at every step
-        (an env's world index), whatever subset steps."""
-        joined: list[Simulation] = []
-        joined_slots: list[int] = []
-        alone = False
-        for sim, slot in zip(sims, slots, strict=True):
-            member = self._members[slot]
-            if ((member is not None and member[0] is sim and member[1] is sim._fused) or self._admit(sim, slot)) \
-                    and sim._sensing.all_due(sim.sim_time_us + sim.interval_us):
-                joined.append(sim)
-                joined_slots.append(slot)
-            else:  # not a fused step that casts every ranger (as Simulation.step would make it), or of another shape
-                sim.step()
-                alone = True
-        if joined:
-            self._step_joined(joined, joined_slots)
-        self.whole = bool(joined) and not alone
+        (an env's world index), whatever subset steps. ``commands``: (len(sims), 3) velocities (vx, vy, va) that
+        robot ``robot`` of each is commanded with (:meth:`Simulation.set_velocity`) just before the step."""
+        slots = list(slots)
+        last = self._last
+        if last is not None and not self._unsure and slots == last[1] and list(sims) == last[0]:
+            joined, rows, noisy = last[2], None, last[3]
+        else:
+            joined_list, rows_list, alone = self._sort(sims, slots)
+            for k in alone:  # each as Simulation.step steps it
+                if commands is not None:
+                    sims[k].set_velocity(robot, *commands[k].tolist())
+                sims[k].step()
+            joined = np.array(joined_list, dtype=np.int64)
+            rows = None if len(rows_list) == len(slots) else np.array(rows_list, dtype=np.int64)
+            noisy = [slot for slot in joined_list if slot in self._noisy]
+            self._last = (list(sims), slots, joined, noisy) if not alone else None
+        self.whole = bool(joined.size) and self._last is not None
+        if joined.size:
+            self._step_held(joined, noisy, commands if commands is None or rows is None else commands[rows], robot)
 
-    def _step_joined(self, sims: list[Simulation], slots: list[int]) -> None:
-        """The compiled call for ``sims`` (each has joined), and what each simulation keeps of it."""
-        poses, layers, odometry, stalled, errors, uses_odom, commands = self._state
-        parity = np.zeros(self.size, dtype=np.int64)
-        given_all = self._given
-        fresh = False  # whether the rows below are written into copies: the last step's are the simulations' arrays
-        for sim, slot in zip(sims, slots, strict=True):
-            sim.sim_time_us += sim.interval_us
-            if sim.watchdog_timeout > 0:
-                sim._stop_silent_robots()
-            sim._sensing.draw_all_noise()
-            parity[slot] = sim._updates % 2
-            given = given_all[slot]
-            if (given is None or given[0] is not sim.true_poses or given[1] is not sim.stalled
-                    or given[2] is not sim.odometry_poses or given[3] is not sim._layer_poses
-                    or given[4] is not sim.odom_errors or given[5] is not sim.commands):
-                if not fresh:
-                    poses, odometry, stalled, fresh = poses.copy(), odometry.copy(), stalled.copy(), True
-                poses[slot], stalled[slot], odometry[slot] = sim.true_poses, sim.stalled, sim.odometry_poses
-                layers[slot], errors[slot], uses_odom[slot] = sim._layer_poses, sim.odom_errors, sim._uses_odom
-                commands[slot] = sim.commands
-                sim.commands = commands[slot]  # the same commands, written in place from now on
-        motion, drives, wheelbases, bounds = self._motion
-        n = commands.shape[1]
-        velocities = motion.body_velocities(commands.reshape(-1, 3), drives, wheelbases, bounds).reshape(-1, n, 3)
-        assert self._fused is not None and self._shape is not None
-        result = self._fused.step(np.array(slots, dtype=np.int64), [sim._fused for sim in sims], poses,
-                                  layers.copy(), parity, odometry, velocities, errors,
-                                  self._shape.interval_us / MICROSECONDS, uses_odom, stalled)
-        assert result.scans is not None
-        published, intensity = result.scans
-        for sim, slot in zip(sims, slots, strict=True):
-            sim.true_poses, sim.stalled, sim.odometry_poses, sim._layer_poses = given = \
-                result.poses[slot], result.stalled[slot], result.odometry[slot], result.layers[slot]
-            given_all[slot] = (*given, sim.odom_errors, sim.commands)
-            sim.velocities = velocities[slot]
-            sim._updates += 1
-            sim._sensing.record_all(published[slot], intensity[slot], sim.sim_time_us)
-        self._state = (result.poses, result.layers, result.odometry, result.stalled, errors, uses_odom, commands)
-        self.poses, self.stalled, self.velocities, self.ranges = result.poses, result.stalled, velocities, published
+    def sync(self, slots: Sequence[int] | None = None) -> None:
+        """Bring the held simulations of ``slots`` (every held one by default) up to date, as their own steps would
+        have left them; they may be read and changed then (the batch checks them at their next step)."""
+        chosen = [slot for slot in range(self.size) if self._held[slot] is not None] if slots is None else slots
+        poses, layers, odometry, stalled, _, _, _, _, velocities, published, intensity = self._state or (None,) * 11
+        for slot in chosen:
+            sim = self._held[slot]
+            if sim is None:
+                continue
+            if self._behind[slot]:
+                sim.sim_time_us, sim._updates = int(self._clock[slot]), int(self._updates[slot])
+                sim.true_poses, sim.stalled, sim.odometry_poses, sim._layer_poses, sim.velocities = \
+                    poses[slot], stalled[slot], odometry[slot], layers[slot], velocities[slot]
+                sim._sensing.record_all(published[slot], intensity[slot], sim.sim_time_us)
+                self._behind[slot] = False
+            self._given[slot] = self._holding(sim)
+            self._unsure.add(slot)
+
+    @staticmethod
+    def _holding(sim: Simulation) -> tuple[object, ...]:
+        """What a held simulation holds that anything changing it replaces: told apart by identity."""
+        return (sim.true_poses, sim.stalled, sim.odometry_poses, sim._layer_poses, sim.odom_errors, sim.commands,
+                sim.last_command_us, sim._fused, sim._sensing)
+
+    def _sort(self, sims: Sequence[Simulation], slots: list[int]) -> tuple[list[int], list[int], list[int]]:
+        """Which of ``sims`` take the call (their slots, and their positions in ``sims``), each taken in unless it
+        is held and unchanged, and which step on their own (positions)."""
+        joined, rows, alone = [], [], []
+        copied = False  # whether the stacked rows below are written into copies (synced simulations hold views)
+        for k, (sim, slot) in enumerate(zip(sims, slots, strict=True)):
+            held = self._held[slot] is sim
+            if held and slot not in self._unsure:
+                joined.append(slot)
+                rows.append(k)
+                continue
+            self._unsure.discard(slot)
+            given = self._given[slot]
+            if (held and given is not None and not self._behind[slot] and sim.watchdog_timeout <= 0
+                    and all(a is b for a, b in zip(given, self._holding(sim), strict=True))):
+                joined.append(slot)  # synced, then left as it was
+                rows.append(k)
+            elif self._admit(sim, slot):
+                if not copied:
+                    self._state = tuple(array.copy() for array in self._state[:4]) + self._state[4:]
+                    copied = True
+                self._take_in(sim, slot)
+                joined.append(slot)
+                rows.append(k)
+            else:
+                self._release(slot)
+                alone.append(k)
+        return joined, rows, alone
 
     def _admit(self, sim: Simulation, slot: int) -> bool:
-        """Whether ``sim`` (new in ``slot``, or with new kernels) takes fused steps that can share the compiled call
-        (of the shape of the first admitted); if so it becomes the slot's member."""
+        """Whether ``sim`` takes fused steps that can share the compiled call (of the shape of the first admitted),
+        every ranger due at every step and no watchdog; if so its fused step is held in ``slot``."""
         fused = sim._fused  # not None: compiled kernels running (none while a background upgrade is under way)
-        if fused is None:
+        if (fused is None or sim.watchdog_timeout > 0
+                or not sim._sensing.due_every_step(sim.sim_time_us + sim.interval_us, sim.interval_us)):
             return False
         shape = _BatchShape.of(sim)
         if self._fused is None:
@@ -539,17 +567,72 @@ class SimulationBatch:
             if batch is None:
                 return False
             self._fused, self._shape = batch(sim.threads), shape
-            self._start(sim)
         if shape != self._shape or not self._fused.fits(fused):
             return False
-        self._members[slot] = (sim, fused)
-        self._given[slot] = None
+        if not self._state:
+            self._start(sim)
+        self._fused.hold(slot, fused)
         return True
+
+    def _take_in(self, sim: Simulation, slot: int) -> None:
+        """Hold ``sim`` in ``slot``: its state copied into the slot's rows, its commands and their times made views
+        of the batch's (written in place from now on)."""
+        poses, layers, odometry, stalled, errors, uses_odom, commands, commanded, *_ = self._state
+        poses[slot], stalled[slot], odometry[slot] = sim.true_poses, sim.stalled, sim.odometry_poses
+        layers[slot], errors[slot], uses_odom[slot] = sim._layer_poses, sim.odom_errors, sim._uses_odom
+        commands[slot], commanded[slot] = sim.commands, sim.last_command_us
+        sim.commands, sim.last_command_us = commands[slot], commanded[slot]
+        self._clock[slot], self._updates[slot] = sim.sim_time_us, sim._updates
+        self._held[slot], self._given[slot] = sim, None
+        self._behind[slot] = False
+        if sim._sensing.noisy:
+            self._noisy[slot] = sim._sensing
+        else:
+            self._noisy.pop(slot, None)
+
+    def _release(self, slot: int) -> None:
+        """The slot holds no simulation (its last one steps on its own)."""
+        self._held[slot] = self._given[slot] = None
+        self._unsure.discard(slot)
+        self._noisy.pop(slot, None)
+        self._behind[slot] = False
+
+    def _step_held(self, slots: np.ndarray, noisy: list[int], commands: np.ndarray | None, robot: int) -> None:
+        """The compiled call for the held simulations of ``slots``, after robot ``robot`` of each is commanded
+        with its row of ``commands`` (when given), stamped at its time before the step."""
+        poses, layers, odometry, stalled, errors, uses_odom, given, commanded, velocities, published, intensity = \
+            self._state
+        clock, updates = self._clock, self._updates
+        if commands is not None:
+            given[slots, robot] = commands
+            commanded[slots, robot] = clock[slots]
+        for slot in noisy:
+            self._noisy[slot].draw_all_noise()
+        clock[slots] += self._shape.interval_us
+        motion, drives, wheelbases, bounds = self._motion
+        n = given.shape[1]
+        moved = motion.body_velocities(given.reshape(-1, 3), drives, wheelbases, bounds).reshape(-1, n, 3)
+        result = self._fused.step(slots, poses, layers.copy(), updates % 2, odometry, moved, errors,
+                                  self._shape.interval_us / MICROSECONDS, uses_odom, stalled)
+        updates[slots] += 1
+        scans, scan_intensity = result.scans
+        carried = self._behind.copy()
+        carried[slots] = False
+        if carried.any():  # slots behind that did not step: their last step's velocities and scans carried over
+            moved[carried], scans[carried], scan_intensity[carried] = \
+                velocities[carried], published[carried], intensity[carried]
+        self._behind[slots] = True
+        self._state = (result.poses, result.layers, result.odometry, result.stalled, errors, uses_odom, given,
+                       commanded, moved, scans, scan_intensity)
+        self.poses, self.stalled, self.velocities, self.ranges = result.poses, result.stalled, moved, scans
 
     def _start(self, sim: Simulation) -> None:
         """The stacked state and the body velocities' call for robots like those of ``sim`` in every slot."""
         w, n = self.size, len(sim.robots)
+        beams = self._fused.beams
         self._state = (np.zeros((w, n, 3)), np.zeros((w, 2, n, 3)), np.zeros((w, n, 3)), np.zeros((w, n), dtype=bool),
-                       np.zeros((w, n, 4)), np.zeros((w, n), dtype=bool), np.zeros((w, n, 3)))
+                       np.zeros((w, n, 4)), np.zeros((w, n), dtype=bool), np.zeros((w, n, 3)),
+                       np.zeros((w, n), dtype=np.int64), np.zeros((w, n, 3)), np.zeros((w, beams), dtype=np.float32),
+                       np.zeros((w, beams), dtype=np.float32))
         self._motion = (backend_for(sim.kernels).motion, group_by_drive([r.settings.drive for r in sim.robots] * w),
                         np.tile(sim.drives.wheelbases, w), np.tile(sim.drives.bounds, (w, 1)))

@@ -102,7 +102,8 @@ def vector(steps: int, **options: object) -> dict[str, object]:
         observations, rewards, terminated, truncated, _ = envs.step(envs.action_space.sample())
         trace.steps += 1
         trace.episodes += int(np.count_nonzero(terminated | truncated))
-        trace.add(observations, rewards, terminated, truncated, *(task.sim.true_poses for task in envs.tasks))
+        poses = [envs.simulation(k).true_poses for k in range(envs.num_envs)]
+        trace.add(observations, rewards, terminated, truncated, *poses)
     return trace.summary()
 
 

@@ -57,16 +57,20 @@ def test_a_simulation_replaces_the_arrays_it_exposed_instead_of_writing_them(ker
 
 def test_simulations_stepped_in_a_batch_replace_the_arrays_they_exposed_too() -> None:
     """The batch copies a world's new state (after a pose set or a reset) into its stacked arrays: new ones, as
-    the last step's rows are the arrays the simulations exposed."""
+    the last step's rows are the arrays the synced simulations exposed."""
     sims = [Simulation(load_world_text(ring_world(6, 0.6), f"ring{k}.world"), seed=k, kernels="numba")
             for k in range(3)]
     batch = SimulationBatch(len(sims))
     kept = []
-    for step in range(60):
-        for sim in sims:
-            disturb(step + sims.index(sim), sim)
+    for step in range(90):
+        if step % 3 == 0:  # changed and read every third step, left behind in the batch between
+            batch.sync()  # up to date before they are changed
+            for sim in sims:
+                disturb(step // 3 + sims.index(sim), sim)
         batch.step(sims, range(len(sims)))
         assert batch.whole
-        for sim in sims:
-            kept += exposed(sim)
+        if step % 3 == 2:
+            batch.sync()
+            for sim in sims:
+                kept += exposed(sim)
     assert_unchanged(kept)

@@ -36,12 +36,13 @@ def frame(sim: Simulation) -> tuple:
             sim.velocities.tobytes(), scans)
 
 
-def lockstep(texts: list[str], kernels: list[str], steps: int, between=None, threads: int = 1,
+def lockstep(texts: list[str], kernels: list[str], steps: int, between=None, threads: int = 1, every: int = 1,
              ) -> tuple[list, list, list[bool]]:
-    """The same worlds stepped one by one and through a batch under the same random commands; ``between(step,
-    sims)`` changes both sets alike between steps and returns the slots to step (None: all). Returns both
-    runs' frames and, per step, whether every world stepped joined the batch's compiled call (the batched
-    simulations on ``threads`` threads)."""
+    """The same worlds stepped one by one and through a batch under the same random commands, new ones every
+    ``every`` steps (the batched simulations synced first, and left behind in the batch between); ``between(step,
+    sims)`` changes both sets alike between steps and returns the slots to step (None: all). Returns both runs'
+    frames at those steps and, per step, whether every world stepped joined the batch's compiled call (the
+    batched simulations on ``threads`` threads)."""
     worlds = [load_world_text(text, f"w{k}.world") for k, text in enumerate(texts)]
     alone = [Simulation(w, seed=k, kernels=kinds) for k, (w, kinds) in enumerate(zip(worlds, kernels, strict=True))]
     batched = [Simulation(w, seed=k, kernels=kinds, threads=threads)
@@ -49,44 +50,51 @@ def lockstep(texts: list[str], kernels: list[str], steps: int, between=None, thr
     batch = SimulationBatch(len(texts))
     rng = np.random.default_rng(7)
     frames_alone, frames_batched, whole = [], [], []
+    slots = list(range(len(texts)))
     for step in range(steps):
-        chosen = None
-        if between is not None:
-            between(step, alone)
-            chosen = between(step, batched)
-        slots = list(range(len(texts))) if chosen is None else chosen
-        for slot in slots:
-            commands = rng.uniform([-0.2, -0.2, -1.0], [0.9, 0.2, 1.0], (len(alone[slot].robots), 3))
-            for sim in (alone[slot], batched[slot]):
-                sim.set_velocities(np.arange(len(sim.robots)), commands)
+        if step % every == 0:
+            batch.sync()  # up to date before they are read or changed
+            frames_alone.append([frame(sim) for sim in alone])
+            frames_batched.append([frame(sim) for sim in batched])
+            if between is not None:
+                between(step, alone)
+                chosen = between(step, batched)
+                slots = list(range(len(texts))) if chosen is None else chosen
+            for slot in range(len(texts)):
+                commands = rng.uniform([-0.2, -0.2, -1.0], [0.9, 0.2, 1.0], (len(alone[slot].robots), 3))
+                for sim in (alone[slot], batched[slot]):
+                    sim.set_velocities(np.arange(len(sim.robots)), commands)
         for slot in slots:
             alone[slot].step()
         batch.step([batched[slot] for slot in slots], slots)
         whole.append(batch.whole)
-        frames_alone.append([frame(sim) for sim in alone])
-        frames_batched.append([frame(sim) for sim in batched])
+    batch.sync()
+    frames_alone.append([frame(sim) for sim in alone])
+    frames_batched.append([frame(sim) for sim in batched])
     return frames_alone, frames_batched, whole
 
 
-@pytest.mark.parametrize("threads", [1, 2])
-def test_worlds_stepped_in_one_call_are_stepped_as_each_alone(monkeypatch, threads):
+@pytest.mark.parametrize(("threads", "every"), [(1, 1), (2, 1), (1, 6)])
+def test_worlds_stepped_in_one_call_are_stepped_as_each_alone(monkeypatch, threads, every):
     """Four worlds of ten robots (noise, odometry errors, robots leaving a huddle so that the robot layers grow
-    inside the batched call), each steps as it steps alone, on one thread or with the worlds shared among two;
-    every step joins the one compiled call."""
+    inside the batched call), each steps as it steps alone, on one thread or with the worlds shared among two,
+    read and commanded at every step or left in the batch for several; every step joins the one compiled call."""
     calls, regrown = [], []
     name = "whole_steps" if threads == 1 else "whole_steps_parallel"
     whole_steps, sense_again = getattr(fused_kernels, name), fused_kernels.sense_again
     monkeypatch.setattr(fused_kernels, name, lambda *args: calls.append(1) or whole_steps(*args))
     monkeypatch.setattr(fused_kernels, "sense_again", lambda *args: regrown.append(1) or sense_again(*args))
     texts = [ring_world(10, radius) for radius in (0.8, 1.0, 1.2, 1.5)]
-    alone, batched, whole = lockstep(texts, ["numba"] * 4, 60, threads=threads)
+    alone, batched, whole = lockstep(texts, ["numba"] * 4, 60, threads=threads, every=every)
     assert batched == alone
     assert len(calls) == 60 and all(whole)
     assert regrown
 
 
-def test_what_happens_between_steps_is_seen_by_the_next_batched_step():
-    """A pose set, a reset and worlds left out of some steps: the batch takes each world's state as it is."""
+@pytest.mark.parametrize("every", [1, 5])
+def test_what_happens_between_steps_is_seen_by_the_next_batched_step(every):
+    """A pose set, a reset and worlds left out of some steps (behind in the batch, read only later, with
+    ``every`` 5): the batch takes each world's state as it is."""
 
     def between(step: int, sims: list[Simulation]) -> list[int] | None:
         if step == 10:
@@ -97,7 +105,7 @@ def test_what_happens_between_steps_is_seen_by_the_next_batched_step():
             sims[0].reset_positions()
         return [0, 2] if 15 <= step < 25 else None
 
-    alone, batched, whole = lockstep([ring_world(6, 1.5)] * 3, ["numba"] * 3, 40, between)
+    alone, batched, whole = lockstep([ring_world(6, 1.5)] * 3, ["numba"] * 3, 40, between, every=every)
     assert batched == alone
     assert all(whole)
 
