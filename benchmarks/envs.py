@@ -49,6 +49,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from stage_sim.backend import KERNELS_ENV
 from stage_sim.envs import NavigateEnv, NavigateParallelEnv, NavigateVectorEnv
 from stage_sim.envs.rollouts import run_parallel, run_single, summarise
 from stage_sim.sim.simulation import Simulation, SimulationBatch
@@ -276,17 +277,17 @@ def world_memory(scenario: str) -> dict:
         finally:
             tracemalloc.stop()
 
-    asked = os.environ.get("STAGE_SIM_KERNELS")
-    os.environ["STAGE_SIM_KERNELS"] = "numba"  # from the first step: numpy's tables are others
+    asked = os.environ.get(KERNELS_ENV)
+    os.environ[KERNELS_ENV] = "numba"  # from the first step: numpy's tables are others
     try:
         held(1)  # the kernels loaded, outside the count
         few, many = 3, 9
         per_world = (held(many) - held(few)) / (many - few)
     finally:
         if asked is None:
-            del os.environ["STAGE_SIM_KERNELS"]
+            del os.environ[KERNELS_ENV]
         else:
-            os.environ["STAGE_SIM_KERNELS"] = asked
+            os.environ[KERNELS_ENV] = asked
     return {"bench": "memory", "env": "NavigateVectorEnv", "scenario": scenario, "worlds": [few, many],
             "kb_per_world": round(per_world / 1e3, 1)}
 
